@@ -1,0 +1,91 @@
+"""Bacteria database (SI "Parameter values of flagellar-wrapping bacteria"): oracle = hand
+calculation from the SI's printed inputs and the schema's own rules."""
+
+import math
+
+import pytest
+
+from flagwrap.bacteria import default_species, format_table, load_species_file
+from flagwrap.errors import UserInputError
+
+
+@pytest.fixture(scope="module")
+def species():
+    return {s.key: s for s in default_species()}
+
+
+def test_all_entries_and_provenance(species):
+    assert set(species) == {"c_insecticola_coil", "c_insecticola_normal", "s_putrefaciens", "p_putida"}
+    for s in species.values():
+        for f in ("radius_um", "length_um", "frequency_hz", "viscosity_pa_s", "n_flagella"):
+            assert s.provenance[f].source, f"{s.key}.{f} lacks a source"
+    # values not printed in the seed are marked as assumptions or gaps, never as seed values
+    assert species["c_insecticola_coil"].provenance["radius_um"].status == "assumption"
+    assert species["c_insecticola_coil"].provenance["pitch_um"].status == "gap"
+    assert species["c_insecticola_coil"].pitch_um is None
+    assert species["c_insecticola_coil"].provenance["n_flagella"].status == "assumption"
+
+
+def test_s_putrefaciens_hand_calculation(species):
+    # oracle: M = eta 2 pi f L^4 / (pi E a^4 / 4) by hand with the SI's numbers; tolerance: round-off
+    s = species["s_putrefaciens"]
+    A = math.pi * 4.5e8 * (10e-9) ** 4 / 4
+    M = 5e-3 * 2 * math.pi * 50 * (6.5e-6) ** 4 / A
+    assert s.machin == pytest.approx(M, rel=1e-12)
+    assert s.radius_over_length_cubed == pytest.approx((0.473 / 6.5) ** 3, rel=1e-12)
+    assert s.instability_ratio() == pytest.approx(M * (0.473 / 6.5) ** 3 / 0.06, rel=1e-12)
+    assert s.side() == "unstable"
+
+
+def test_sides_against_paper(species):
+    # oracle: the paper's statement; P. putida lands stable with the SI's own numbers (reported)
+    assert species["c_insecticola_coil"].side() == "unstable"
+    assert species["c_insecticola_normal"].side() == "stable"
+    assert species["s_putrefaciens"].side() == "unstable"
+    assert species["p_putida"].side() == "stable"
+    assert species["p_putida"].paper_side == "unstable"
+    need = species["p_putida"].crossing_inputs()
+    assert need["viscosity_pa_s"] == pytest.approx(2e-4 / species["p_putida"].instability_ratio(), rel=1e-12)
+
+
+def test_crossing_inputs_land_on_boundary(species):
+    # oracle: M/M_c = 1 after replacing one input; tolerance: round-off
+    from dataclasses import replace
+
+    s = species["p_putida"]
+    need = s.crossing_inputs()
+    for f in ("viscosity_pa_s", "frequency_hz", "length_um", "radius_um"):
+        assert replace(s, **{f: need[f]}).instability_ratio() == pytest.approx(1.0, rel=1e-10)
+
+
+def test_table_marks_disagreement(species):
+    text = format_table(list(species.values()))
+    assert "unstable!" in text and "Pseudomonas putida" in text
+
+
+def test_user_file(tmp_path):
+    p = tmp_path / "mine.toml"
+    p.write_text(
+        '[[species]]\nkey = "v_fischeri"\nname = "Aliivibrio fischeri"\nradius_um = 0.5\nlength_um = 6.0\n'
+        'frequency_hz = 100.0\nviscosity_pa_s = { value = 1e-3, status = "assumption", source = "water" }\n'
+        "n_flagella = 3\n"
+    )
+    (s,) = load_species_file(p)
+    assert s.youngs_modulus_pa == 4.5e8 and s.filament_radius_nm == 10.0
+    assert s.provenance["viscosity_pa_s"].status == "assumption"
+
+
+@pytest.mark.parametrize(
+    "body, match",
+    [
+        ('[[species]]\nkey = "x"\nradius_um = -1\nlength_um = 6\nfrequency_hz = 1\nviscosity_pa_s = 1\nn_flagella = 1\n', "radius_um"),
+        ('[[species]]\nkey = "x"\nradius_um = 1\nlength_um = 6\nfrequency_hz = 1\nviscosity_pa_s = 1\nn_flagella = 1.5\n', "n_flagella"),
+        ('[[species]]\nkey = "x"\nradius_um = 1\nlength_um = 6\nfrequency_hz = 1\nn_flagella = 1\n', "viscosity_pa_s"),
+        ("not toml = = 1", "invalid TOML"),
+    ],
+)
+def test_user_file_errors(tmp_path, body, match):
+    p = tmp_path / "bad.toml"
+    p.write_text(body)
+    with pytest.raises(UserInputError, match=match):
+        load_species_file(p)
