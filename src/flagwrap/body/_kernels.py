@@ -1,0 +1,62 @@
+"""Numba kernels: distance to a capped cylinder and the WCA repulsion.
+
+Body axis = +z; the hemispherical cap of radius ``Rc`` is centred at ``(0, 0, Rc)`` so its
+lowest point is the origin (the clamp); the cylinder continues up to ``z = Rc + H``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+
+
+@nb.njit(cache=True, inline="always")
+def surface_distance(px, py, pz, Rc, H):
+    """Signed distance to the body surface (negative inside) and its unit gradient."""
+    if pz < Rc:
+        dx, dy, dz = px, py, pz - Rc
+        r = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if r == 0.0:
+            return -Rc, 0.0, 0.0, -1.0
+        return r - Rc, dx / r, dy / r, dz / r
+    rho = math.sqrt(px * px + py * py)
+    ztop = Rc + H
+    if pz <= ztop:
+        if rho == 0.0:
+            return -Rc, 1.0, 0.0, 0.0
+        d_side = rho - Rc
+        if d_side < 0.0 and (ztop - pz) < -d_side:  # inside, nearer the top face
+            return pz - ztop, 0.0, 0.0, 1.0
+        return d_side, px / rho, py / rho, 0.0
+    # above the top face
+    if rho <= Rc:
+        return pz - ztop, 0.0, 0.0, 1.0
+    dr = rho - Rc
+    dz = pz - ztop
+    d = math.sqrt(dr * dr + dz * dz)
+    return d, dr / d * px / rho, dr / d * py / rho, dz / d
+
+
+@nb.njit(cache=True)
+def wca_energy_grad(x, first, Rc, H, sigma, eps, grad, dist):
+    """WCA repulsion of beads ``first..`` from the body; adds dU/dx to ``grad``.
+
+    ``U(d) = 4 eps [(sigma/d)^12 - (sigma/d)^6] + eps`` for ``d < 2^(1/6) sigma``, 0 beyond.
+    ``dist`` (N,) receives each bead's signed distance. Returns the energy; a bead inside
+    (d <= 0) gets zero force here and is caught by the guards.
+    """
+    cut = 2.0 ** (1.0 / 6.0) * sigma
+    E = 0.0
+    for i in range(x.shape[0]):
+        d, gx, gy, gz = surface_distance(x[i, 0], x[i, 1], x[i, 2], Rc, H)
+        dist[i] = d
+        if i < first or d >= cut or d <= 0.0:
+            continue
+        s6 = (sigma / d) ** 6
+        E += 4.0 * eps * (s6 * s6 - s6) + eps
+        dU = 4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / d
+        grad[i, 0] += dU * gx
+        grad[i, 1] += dU * gy
+        grad[i, 2] += dU * gz
+    return E

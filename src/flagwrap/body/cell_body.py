@@ -1,0 +1,62 @@
+"""The cell body as an object: geometry plus the contact law (swap either without ``if``s)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flagwrap.body import _kernels as K
+
+
+class CappedCylinder:
+    """Rigid cylinder of radius ``radius`` and length ``length`` closed below by a hemisphere.
+
+    Lengths in core units. The lowest point of the cap is the origin. The fluid passes through
+    the body (paper, Methods): it acts on the filament only by the WCA repulsion of range
+    ``cutoff`` (bead centre to surface) and energy ``strength``.
+
+    Parameters
+    ----------
+    radius, length : float
+        ``R_cell``, cylinder length ``H``.
+    cutoff : float
+        distance from the surface below which beads are repelled (``a (1 + range)``).
+    strength : float
+        WCA energy ``eps`` (core energy units).
+    first_bead : int
+        beads with a smaller index (the clamp) feel no contact force.
+    """
+
+    def __init__(self, radius, length, cutoff, strength, first_bead=2):
+        self.radius = float(radius)
+        self.length = float(length)
+        self.cutoff = float(cutoff)
+        self.sigma = self.cutoff / 2.0 ** (1.0 / 6.0)
+        self.strength = float(strength)
+        self.first_bead = int(first_bead)
+
+    def energy_grad(self, x: np.ndarray, grad: np.ndarray, dist: np.ndarray) -> float:
+        """Adds ``dU/dx`` into ``grad`` and writes signed distances into ``dist``."""
+        return K.wca_energy_grad(x, self.first_bead, self.radius, self.length, self.sigma,
+                                 self.strength, grad, dist)
+
+    def distance(self, x: np.ndarray) -> np.ndarray:
+        """Signed distance of each point to the surface (negative inside)."""
+        grad = np.zeros_like(x)
+        dist = np.empty(len(x))
+        K.wca_energy_grad(x, len(x), self.radius, self.length, self.sigma, 0.0, grad, dist)
+        return dist
+
+
+class NoBody:
+    """No cell body (an isolated filament)."""
+
+    radius = 0.0
+    length = 0.0
+    first_bead = 0
+
+    def energy_grad(self, x, grad, dist):
+        dist[:] = np.inf
+        return 0.0
+
+    def distance(self, x):
+        return np.full(len(x), np.inf)

@@ -1,0 +1,1 @@
+"""The ``flagwrap`` command line: a registry of subcommand modules (see :mod:`flagwrap.cli.main`)."""

@@ -1,0 +1,9 @@
+"""Exceptions with a user-facing meaning."""
+
+
+class UserInputError(ValueError):
+    """A parameter, config file or input file the user can fix; the CLI exits with code 2."""
+
+
+class SimulationError(RuntimeError):
+    """A run that cannot continue (NaN, overlap, step size underflow); partial output is kept."""

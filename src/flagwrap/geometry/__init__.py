@@ -1,0 +1,1 @@
+"""Initial shapes and frame algebra (parallel transport, rotations)."""

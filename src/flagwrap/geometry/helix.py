@@ -1,0 +1,143 @@
+"""The stress-free helix hanging from the clamp.
+
+Layout (body axis = z, the cell body above z = 0, the clamp at the lowest point of the cap,
+the origin): bead 0 sits at the clamp and the first bond points straight down along the body
+axis (the paper's "vertically clamped" driving end, Discussion). From bead 1 on, the filament
+is a uniform helix of radius ``R`` and pitch ``P`` whose axis is parallel to the body axis and
+passes at distance ``R`` from it, so that the helix starts on the body axis where the clamped
+bond ends. The kink between the vertical bond and the helix (angle ``psi``) is part of the
+stress-free shape, so the whole initial configuration is an exact equilibrium.
+
+The paper does not print the shape of the rod next to the clamp; this is the simplest choice
+that has a vertical clamped end and a uniform helix (see docs/model.md, "Clamp geometry").
+
+Consecutive helix beads are spaced by an exact chord ``b = L / (N - 1)``, so the discrete
+contour length is exactly ``L``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _chord_angle(R: float, p: float, b: float) -> float:
+    """Helix parameter step ``dphi`` with chord ``b``: 2 R^2 (1 - cos dphi) + p^2 dphi^2 = b^2."""
+    x = b / math.hypot(R, p)
+    for _ in range(50):
+        g = 2 * R * R * (1 - math.cos(x)) + p * p * x * x - b * b
+        dg = 2 * R * R * math.sin(x) + 2 * p * p * x
+        step = g / dg
+        x -= step
+        if abs(step) < 1e-15 * max(x, 1e-300):
+            break
+    return x
+
+
+def helix_positions(length, helix_radius, pitch, n_beads, handedness="left"):
+    """Bead positions of the hanging helix [same length unit as the inputs], shape (N, 3).
+
+    Parameters
+    ----------
+    length, helix_radius, pitch : float
+        ``L``, ``R``, ``P``.
+    n_beads : int
+        ``N``.
+    handedness : {"left", "right"}
+
+    Notes
+    -----
+    With ``p = P / 2 pi`` the helix is ``(R - R cos phi, -h R sin phi, -b - p phi)`` with
+    ``h = +1`` for left- and ``-1`` for right-handed (a left-handed helix has negative torsion).
+    """
+    N = int(n_beads)
+    b = length / (N - 1)
+    R = helix_radius
+    p = pitch / (2 * math.pi)
+    h = 1.0 if handedness == "left" else -1.0
+    dphi = _chord_angle(R, p, b)
+    x = np.zeros((N, 3))
+    x[1] = (0.0, 0.0, -b)
+    phi = dphi * np.arange(N - 1)
+    x[1:, 0] = R - R * np.cos(phi)
+    x[1:, 1] = -h * R * np.sin(phi)
+    x[1:, 2] = -b - p * phi
+    return x
+
+
+def ramp_helix_positions(length, helix_radius, pitch, n_beads, handedness="left", lead_turns=0.5):
+    """Bead positions of a helix centred on the body axis with a radius ramp at the clamp.
+
+    Bead 0 at the origin, bead 1 at ``(0, 0, -b)`` (vertical clamped bond); then the curve
+    ``(r cos phi, h r sin phi, -b - p phi)`` with ``r = R (1 - cos(pi phi/phi_r))/2`` for
+    ``phi < phi_r = 2 pi lead_turns`` and ``r = R`` beyond (tangent continuous, vertical at the
+    clamp). Beads are marched along the curve at exact chord ``b`` (secant root finding), so the
+    discrete contour length is exactly ``L``. ``h = +1`` gives a left-handed helix (negative
+    torsion; descending, it turns counter-clockwise seen from above), ``h = -1`` a right-handed one.
+    """
+    N = int(n_beads)
+    b = length / (N - 1)
+    R = helix_radius
+    p = pitch / (2 * math.pi)
+    h = 1.0 if handedness == "left" else -1.0
+    phi_r = 2 * math.pi * lead_turns
+
+    def curve(phi):
+        r = R * 0.5 * (1 - math.cos(math.pi * phi / phi_r)) if phi < phi_r else R
+        return np.array([r * math.cos(phi), h * r * math.sin(phi), -b - p * phi])
+
+    x = np.zeros((N, 3))
+    x[1] = (0.0, 0.0, -b)
+    phi = 0.0
+    dphi0 = b / math.hypot(R, p)
+    for k in range(2, N):
+        prev = x[k - 1]
+        # bracket the parameter where the chord from the previous bead reaches b
+        lo, hi = phi, phi + min(dphi0, b / p if p > 0 else dphi0)
+        while np.linalg.norm(curve(hi) - prev) < b:
+            lo, hi = hi, hi + dphi0
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if np.linalg.norm(curve(mid) - prev) < b:
+                lo = mid
+            else:
+                hi = mid
+            if hi - lo < 1e-15 * max(1.0, hi):
+                break
+        phi = 0.5 * (lo + hi)
+        x[k] = curve(phi)
+    return x
+
+
+def filament_positions(fil, clamp=None) -> np.ndarray:
+    """Initial positions [m] of a :class:`flagwrap.params.Filament` with a clamp lead."""
+    if clamp is None or clamp.lead == "ramp":
+        lt = 0.5 if clamp is None else clamp.lead_turns
+        return ramp_helix_positions(fil.length, fil.helix_radius, fil.pitch, fil.n_beads,
+                                    fil.handedness, lt)
+    return helix_positions(fil.length, fil.helix_radius, fil.pitch, fil.n_beads, fil.handedness)
+
+
+def min_nonlocal_distance(fil, clamp=None) -> float:
+    """Smallest distance [m] between beads that are not contour neighbours within ``2a``.
+
+    Beads closer than ``2a`` along the contour may overlap by construction (fine
+    discretisations); any other pair closer than ``2a`` is a self-overlapping initial shape.
+    """
+    x = filament_positions(fil, clamp)
+    N = len(x)
+    b = fil.bond_length
+    skip = int(math.ceil(2 * fil.cross_section_radius / b)) + 1
+    if N > 4000:  # subsample rows to keep validation O(N) memory; exact enough for a guard
+        idx = np.linspace(0, N - 1, 4000).astype(int)
+    else:
+        idx = np.arange(N)
+    best = np.inf
+    for i in idx:
+        j0 = i + skip + 1
+        if j0 >= N:
+            continue
+        d = np.linalg.norm(x[j0:] - x[i], axis=1).min()
+        best = min(best, d)
+    return float(best)

@@ -1,0 +1,41 @@
+"""Integrator interface.
+
+An integrator advances ``dy/dt = Mob(y) G(y) + omega e_phi`` of a
+:class:`flagwrap.model.RodSystem` by one step ``h`` at constant motor speed ``omega``. It is a
+pure function of (system, y, base, info, h, omega): the time loop (:mod:`flagwrap.simulation`)
+owns time, output and the phase switches of the motor.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class StepResult:
+    accepted: bool
+    y: np.ndarray | None  # new state (None if rejected)
+    info: object | None  # ForceInfo at the new state (its frames are the next base)
+    h_next: float  # suggested next step
+    error: float  # scaled error estimate (<= 1 accepted); nan for fixed-step schemes
+    reason: str = ""
+
+
+class Integrator:
+    """Interface; ``order`` is the classical order, ``adaptive`` whether ``h`` is controlled."""
+
+    order: int = 1
+    adaptive: bool = False
+    name: str = "base"
+
+    def step(self, system, y, base, info, h, omega) -> StepResult:  # pragma: no cover
+        raise NotImplementedError
+
+
+def scaled_error(system, err: np.ndarray, tol: float) -> float:
+    """Max-norm of the local error: positions against ``tol`` [L], twist angles against ``10 tol``."""
+    ex = np.abs(err[system.sl_x]).max() / tol if system.nb else 0.0
+    et = np.abs(err[system.sl_th]).max() / (10.0 * tol) if system.ne else 0.0
+    return float(max(ex, et))

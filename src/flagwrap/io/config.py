@@ -1,0 +1,179 @@
+"""TOML <-> :class:`flagwrap.params.Config`, strictly.
+
+Unknown sections or keys, wrong types and impossible values raise
+:class:`~flagwrap.errors.UserInputError` naming the key, before any work starts. Nothing is
+evaluated: TOML values are data only.
+
+Units: SI by default. An optional ``[units]`` table rescales inputs, e.g.
+``length = "mm"`` (lengths of ``filament`` and ``body``), ``pressure = "MPa"`` (Young's
+modulus), ``viscosity = "mPa s"``, ``density = "g/cm3"``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from pathlib import Path
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from flagwrap.errors import UserInputError
+from flagwrap.params import CellBody, Clamp, Config, Contact, Filament, Fluid, Motor, Numerics, Phase
+
+_SECTIONS = {
+    "filament": Filament,
+    "fluid": Fluid,
+    "body": CellBody,
+    "motor": Motor,
+    "contact": Contact,
+    "numerics": Numerics,
+    "clamp": Clamp,
+}
+_LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "micron": 1e-6, "nm": 1e-9}
+_PRESSURE = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
+_VISCOSITY = {"Pa s": 1.0, "mPa s": 1e-3, "cP": 1e-3}
+_DENSITY = {"kg/m3": 1.0, "g/cm3": 1e3}
+_LENGTH_KEYS = {
+    "filament": ("length", "helix_radius", "pitch", "cross_section_radius", "hydrodynamic_radius"),
+    "body": ("radius", "cylinder_length"),
+}
+
+
+def _fields(cls):
+    return {f.name: f for f in dataclasses.fields(cls)}
+
+
+def _check_types(section: str, cls, table: dict):
+    if not isinstance(table, dict):
+        raise UserInputError(f"[{section}] must be a table, got {type(table).__name__}")
+    known = _fields(cls)
+    for key, value in table.items():
+        if key not in known:
+            raise UserInputError(
+                f"unknown key {section}.{key}; allowed: {', '.join(sorted(known))}"
+            )
+        if isinstance(value, (dict, list)) and not (section == "motor" and key == "protocol"):
+            raise UserInputError(f"{section}.{key} must be a single value, got {type(value).__name__}")
+        if isinstance(value, float) and not math.isfinite(value):
+            raise UserInputError(f"{section}.{key} must be finite, got {value}")
+
+
+def _unit(table: dict, key: str, choices: dict, default: str) -> float:
+    name = table.get(key, default)
+    if name not in choices:
+        raise UserInputError(f"units.{key} must be one of {', '.join(choices)}, got {name!r}")
+    return choices[name]
+
+
+def config_from_dict(data: dict, name: str | None = None) -> Config:
+    if not isinstance(data, dict):
+        raise UserInputError("config must be a TOML table")
+    data = dict(data)
+    allowed_top = set(_SECTIONS) | {"units", "name"}
+    for key in data:
+        if key not in allowed_top:
+            raise UserInputError(f"unknown section or key {key!r}; allowed: {', '.join(sorted(allowed_top))}")
+    for req in ("filament", "motor"):
+        if req not in data:
+            raise UserInputError(f"missing required section [{req}]")
+    u = data.pop("units", {}) or {}
+    if not isinstance(u, dict):
+        raise UserInputError("[units] must be a table")
+    for key in u:
+        if key not in ("length", "pressure", "viscosity", "density"):
+            raise UserInputError(f"unknown key units.{key}; allowed: density, length, pressure, viscosity")
+    lf = _unit(u, "length", _LENGTH, "m")
+    pf = _unit(u, "pressure", _PRESSURE, "Pa")
+    vf = _unit(u, "viscosity", _VISCOSITY, "Pa s")
+    df = _unit(u, "density", _DENSITY, "kg/m3")
+    kwargs = {}
+    for section, cls in _SECTIONS.items():
+        table = data.get(section, {})
+        _check_types(section, cls, table)
+        table = dict(table)
+        for key in _LENGTH_KEYS.get(section, ()):
+            if isinstance(table.get(key), (int, float)) and not isinstance(table.get(key), bool):
+                table[key] = table[key] * lf
+        if section == "filament":
+            if isinstance(table.get("youngs_modulus"), (int, float)):
+                table["youngs_modulus"] = table["youngs_modulus"] * pf
+            if isinstance(table.get("density"), (int, float)):
+                table["density"] = table["density"] * df
+        if section == "fluid":
+            if isinstance(table.get("viscosity"), (int, float)):
+                table["viscosity"] = table["viscosity"] * vf
+            if isinstance(table.get("density"), (int, float)):
+                table["density"] = table["density"] * df
+        if section == "motor" and "protocol" in table:
+            prot = table["protocol"]
+            if not isinstance(prot, list):
+                raise UserInputError("motor.protocol must be an array of tables")
+            phases = []
+            for k, p in enumerate(prot):
+                if not isinstance(p, dict):
+                    raise UserInputError(f"motor.protocol[{k}] must be a table")
+                _check_types(f"motor.protocol[{k}]", Phase, p)
+                missing = [f for f in ("direction", "turns") if f not in p]
+                if missing:
+                    raise UserInputError(f"motor.protocol[{k}] is missing {', '.join(missing)}")
+                phases.append(Phase(**p))
+            table["protocol"] = tuple(phases)
+        try:
+            kwargs[section] = cls(**table)
+        except TypeError as exc:  # missing required fields
+            msg = str(exc)
+            missing = msg.split("argument")[-1].strip(": ") if "missing" in msg else msg
+            raise UserInputError(f"[{section}] is missing required value(s): {missing}") from None
+    nm = data.get("name", name or "run")
+    if not isinstance(nm, str) or not nm:
+        raise UserInputError("name must be a non-empty string")
+    return Config(name=nm, **kwargs)
+
+
+def load_config(path) -> Config:
+    """Read a TOML config file; every problem is a one-line :class:`UserInputError`."""
+    path = Path(path)
+    if not path.is_file():
+        raise UserInputError(f"config file not found: {path}")
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise UserInputError(f"malformed TOML in {path}: {exc}") from None
+    except UnicodeDecodeError:
+        raise UserInputError(f"{path} is not a UTF-8 text file") from None
+    return config_from_dict(data, name=path.stem)
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    raise TypeError(type(v))
+
+
+def config_to_toml(cfg: Config) -> str:
+    """Serialise a config (SI units) to TOML text that :func:`load_config` reads back."""
+    d = cfg.to_dict()
+    lines = [f"name = {_toml_value(d.pop('name'))}", ""]
+    for section in ("filament", "fluid", "body", "motor", "clamp", "contact", "numerics"):
+        table = d.get(section, {})
+        lines.append(f"[{section}]")
+        for k, v in table.items():
+            if k == "protocol":
+                items = ", ".join(
+                    "{ " + ", ".join(f"{pk} = {_toml_value(pv)}" for pk, pv in p.items()) + " }"
+                    for p in v
+                )
+                lines.append(f"protocol = [{items}]")
+            else:
+                lines.append(f"{k} = {_toml_value(v)}")
+        lines.append("")
+    return "\n".join(lines)

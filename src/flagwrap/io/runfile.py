@@ -1,0 +1,153 @@
+"""Run files: one self-describing netCDF4/HDF5 file per run (xarray + h5netcdf).
+
+Contents (SI units in each variable's ``units`` attribute):
+
+=====================  =====================  ==============================================
+variable               dims                   meaning
+=====================  =====================  ==============================================
+time                   (time)                 [s]
+turns                  (time)                 t / T, T = 2 pi / omega (reference speed)
+position               (time, bead, xyz)      bead centres [m]; body axis +z, clamp at origin
+twist_angle            (time, bond)           material-frame angle theta [rad]
+director               (time, bond, xyz)      material director m1 (unit)
+motor_angle            (time)                 phi [rad], positive = CCW seen from the free end
+omega                  (time)                 signed motor angular velocity [rad/s]
+motor_torque           (time)                 N_m [N m] about the outward axis (CCW positive)
+motor_torque_reduced   (time)                 N_m R / A
+tip_position           (time, xyz)            free end r(L) [m]
+elastic_energy         (time)                 [J]
+contact_energy         (time)                 [J]
+min_body_distance      (time)                 bead centre to body surface [m]
+max_bond_strain        (time)                 max |l/l0 - 1|
+=====================  =====================  ==============================================
+
+Global attributes: ``flagwrap_version``, ``format_version``, ``config_toml`` (the full input,
+re-loadable), ``status`` ("completed" or "failed"), ``message``, ``machin`` (M), ``reynolds``,
+``omega_ratio_scaling`` (M / (0.06 (R/L)^-3)), scales, step counts and wall time. Files are
+written to a temporary name, flushed, fsynced and renamed, so a crash never leaves a
+half-written file under the final name.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from flagwrap import __version__
+from flagwrap.errors import UserInputError
+
+FORMAT_VERSION = 1
+
+
+def trajectory_dataset(traj):
+    import xarray as xr
+
+    from flagwrap.io.config import config_to_toml
+
+    cfg = traj.config
+    sc = cfg.scales
+    a = traj.arrays()
+    L = sc.length
+    t_si = a["t"] * sc.time
+    x_si = a["x"] * L
+    fil = cfg.filament
+    torque_si = a["motor_torque"] * sc.torque
+    ds = xr.Dataset(
+        {
+            "turns": ("time", a["t"] / (2 * np.pi), {"units": "1", "long_name": "t/T"}),
+            "position": (("time", "bead", "xyz"), x_si, {"units": "m"}),
+            "twist_angle": (("time", "bond"), a["theta"], {"units": "rad"}),
+            "director": (("time", "bond", "xyz"), a["m1"], {"units": "1",
+                                                            "long_name": "material director m1"}),
+            "motor_angle": ("time", a["phi"], {"units": "rad"}),
+            "omega": ("time", a["omega"] * sc.omega, {"units": "rad/s"}),
+            "motor_torque": ("time", torque_si, {"units": "N m"}),
+            "motor_torque_reduced": ("time", torque_si * fil.helix_radius / fil.bending_modulus,
+                                     {"units": "1", "long_name": "N_m R / A"}),
+            "tip_position": (("time", "xyz"), x_si[:, -1, :], {"units": "m"}),
+            "elastic_energy": ("time", a["elastic_energy"] * sc.energy, {"units": "J"}),
+            "contact_energy": ("time", a["contact_energy"] * sc.energy, {"units": "J"}),
+            "min_body_distance": ("time", a["min_distance"] * L, {"units": "m"}),
+            "max_bond_strain": ("time", a["max_strain"], {"units": "1"}),
+        },
+        coords={"time": ("time", t_si, {"units": "s"}), "xyz": ["x", "y", "z"]},
+        attrs={
+            "title": f"flagwrap run {cfg.name}",
+            "flagwrap_version": __version__,
+            "format_version": FORMAT_VERSION,
+            "config_toml": config_to_toml(cfg),
+            "status": traj.status,
+            "message": traj.message,
+            "machin": cfg.machin,
+            "reynolds": cfg.reynolds,
+            "omega_ratio_scaling": cfg.omega_ratio_scaling,
+            "machin_critical_scaling": cfg.machin_critical_scaling,
+            "omega": sc.omega,
+            "period": sc.period,
+            "length": L,
+            "bending_modulus": fil.bending_modulus,
+            "twist_modulus": fil.twist_modulus,
+            "helix_radius": fil.helix_radius,
+            "pitch": fil.pitch,
+            "pitch_angle_deg": fil.pitch_angle_deg,
+            "turns_of_helix": fil.turns,
+            "n_steps": traj.n_steps,
+            "n_rejected": traj.n_rejected,
+            "wall_time_s": traj.wall_time,
+            "integrator": cfg.numerics.integrator,
+            "hydrodynamics": int(cfg.numerics.hydrodynamics),
+            "conventions": "body axis +z, clamp at origin, filament hangs toward -z; "
+                           "rotation sign: positive = CCW seen from the free end",
+        },
+    )
+    return ds
+
+
+def write_run(traj, path) -> Path:
+    """Write a trajectory atomically to ``path`` (netCDF4/HDF5)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    ds = trajectory_dataset(traj)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def read_run(path):
+    """Open a run file; raise :class:`UserInputError` if it is not a readable flagwrap run."""
+    import xarray as xr
+
+    path = Path(path)
+    if not path.is_file():
+        raise UserInputError(f"run file not found: {path}")
+    try:
+        ds = xr.load_dataset(path, engine="h5netcdf")
+    except Exception as exc:  # truncated / not HDF5
+        raise UserInputError(f"{path} is not a readable run file (truncated or not netCDF4): {exc}") from None
+    fv = ds.attrs.get("format_version")
+    if fv is None or "config_toml" not in ds.attrs:
+        raise UserInputError(f"{path} is not a flagwrap run file (no format_version/config)")
+    if int(fv) > FORMAT_VERSION:
+        raise UserInputError(
+            f"{path} has format_version {fv}, newer than this flagwrap ({__version__}) reads "
+            f"({FORMAT_VERSION}); upgrade flagwrap"
+        )
+    return ds
+
+
+def config_of(ds):
+    """The :class:`~flagwrap.params.Config` stored in a run dataset."""
+    from flagwrap.io.config import config_from_dict, tomllib
+
+    return config_from_dict(tomllib.loads(ds.attrs["config_toml"]))

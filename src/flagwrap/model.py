@@ -1,0 +1,259 @@
+"""The assembled physical system in core units: forces, mobilities, motor, state packing.
+
+:class:`RodSystem` is built once from a :class:`flagwrap.params.Config` and is then a set of
+pure functions of the state vector ``y``:
+
+* ``y = [x_free (3 n_b), theta_free (n_e), phi]``: positions of the free beads (2..N-1),
+  twist angles of the free bonds (1..N-2) and the motor angle ``phi``;
+* generalized forces ``G(y) = -dU/dy`` (elastic + contact + gravity), ``G_phi = 0``;
+* equation of motion (paper, Methods, Stokesian dynamics): ``dy/dt = Mob(y) G(y) + omega(t) e_phi``
+  with ``Mob = (1/M) blockdiag(mu_hat_RPY, 1/(8 pi a^3 w_j), 0)``.
+
+The reference frames (parallel transported in time) are carried outside ``y`` in a
+:class:`~flagwrap.elasticity.rod.Frames` "base", updated after each accepted step.
+
+Modelling choices (documented in docs/model.md): the two clamped beads belong to the motor and
+are hydrodynamically inert (the body is transparent to the fluid, as in the paper); each bead's
+rotational drag ``8 pi eta a^3`` is shared by its two bonds, so a bond carries
+``w_j = 1`` (interior) or ``1.5`` (end bonds) bead drags and a rigidly twirled straight rod needs
+``N * 8 pi eta a^3 omega``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from flagwrap import units
+from flagwrap.body.cell_body import CappedCylinder, NoBody
+from flagwrap.elasticity import _kernels as EK
+from flagwrap.elasticity.rod import Frames, RestState, initial_frames, rest_state
+from flagwrap.geometry.helix import filament_positions
+from flagwrap.hydrodynamics.mobility import make_mobility
+from flagwrap.motor.clamp import AxialClamp
+from flagwrap.motor.protocol import Schedule
+
+
+@dataclass
+class ForceInfo:
+    """Everything computed with the generalized forces (kept for observables)."""
+
+    G: np.ndarray
+    x: np.ndarray
+    theta: np.ndarray
+    frames: Frames
+    elastic_energy: float
+    contact_energy: float
+    grad_x: np.ndarray
+    grad_theta: np.ndarray
+    distance: np.ndarray
+
+
+class RodSystem:
+    """Forces, mobility and bookkeeping of one run (core units)."""
+
+    def __init__(self, config, x0=None, theta0=None, body=None, clamp=None, mobility=None):
+        self.config = config
+        fil = config.filament
+        L = fil.length
+        self.scales = config.scales
+        self.machin = config.machin
+        x0 = filament_positions(fil, config.clamp) / L if x0 is None else np.asarray(x0, float)
+        N = len(x0)
+        self.N = N
+        theta0 = np.zeros(N - 1) if theta0 is None else np.asarray(theta0, float)
+        frames = initial_frames(x0)
+        b = fil.bond_length / L
+        self.bond = b
+        self.rest: RestState = rest_state(
+            x0, frames, theta0,
+            bending=1.0,
+            twist=fil.twist_modulus / fil.bending_modulus,
+            stretch=fil.stretch_stiffness / b**3,
+        )
+        self.frames0 = frames
+        self.x0 = x0
+        self.theta0 = theta0
+        self.clamp = clamp or AxialClamp(x0, theta0)
+        nc, ec = self.clamp.n_beads, self.clamp.n_edges
+        self.nc, self.ec = nc, ec
+        self.nb = N - nc  # free beads
+        self.ne = N - 1 - ec  # free bonds
+        self.ny = 3 * self.nb + self.ne + 1
+        self.sl_x = slice(0, 3 * self.nb)
+        self.sl_th = slice(3 * self.nb, 3 * self.nb + self.ne)
+        # hydrodynamics (radius in core units)
+        self.radius = fil.bead_radius / L
+        self.mobility = mobility or make_mobility(config.numerics.hydrodynamics, self.radius)
+        w = np.ones(N - 1)
+        w[0] += 0.5
+        w[-1] += 0.5
+        self.rot_drag = 8.0 * math.pi * self.radius**3 * w  # geometric, times M gives core drag
+        # cell body
+        if config.body.enabled:
+            R = fil.helix_radius
+            self.body = body or CappedCylinder(
+                radius=config.body.resolved_radius(R) / L,
+                length=config.body.resolved_length(R) / L,
+                cutoff=fil.cross_section_radius * (1.0 + config.contact.range) / L,
+                strength=config.contact.strength / b,
+                first_bead=nc,
+            )
+        else:
+            self.body = body or NoBody()
+        # gravity/buoyancy: force per bead (core units), along -z
+        self.gravity = np.zeros((N, 3))
+        if fil.density is not None:
+            dm = (fil.density - config.fluid.density) * units.G_ACCEL * math.pi * fil.cross_section_radius**2
+            per_bead = np.full(N, fil.bond_length)
+            per_bead[0] = per_bead[-1] = 0.5 * fil.bond_length
+            self.gravity[:, 2] = -dm * per_bead / self.scales.force
+        self.schedule = Schedule(config.motor.protocol)
+        self._colors = None
+
+    # packing -------------------------------------------------------------------------------
+    def initial_y(self) -> np.ndarray:
+        return self.pack(self.x0, self.theta0, 0.0)
+
+    def pack(self, x, theta, phi) -> np.ndarray:
+        y = np.empty(self.ny)
+        y[self.sl_x] = x[self.nc:].ravel()
+        y[self.sl_th] = theta[self.ec:]
+        y[-1] = phi
+        return y
+
+    def unpack(self, y):
+        phi = y[-1]
+        x = np.empty((self.N, 3))
+        x[: self.nc] = self.clamp.positions(phi)
+        x[self.nc:] = y[self.sl_x].reshape(-1, 3)
+        theta = np.empty(self.N - 1)
+        theta[: self.ec] = self.clamp.theta(phi)
+        theta[self.ec:] = y[self.sl_th]
+        return x, theta, phi
+
+    # forces --------------------------------------------------------------------------------
+    def forces(self, y: np.ndarray, base: Frames) -> ForceInfo:
+        x, theta, phi = self.unpack(y)
+        r = self.rest
+        gx = np.empty_like(x)
+        gth = np.empty(self.N - 1)
+        d1 = np.empty_like(base.d1)
+        rt = np.empty_like(base.rt)
+        E = EK.energy_grad(x, theta, base.t, base.d1, base.rt, r.l0, r.vor, r.kbar, r.mbar,
+                           r.bending, r.twist, r.stretch, gx, gth, d1, rt)
+        dist = np.empty(self.N)
+        Ec = self.body.energy_grad(x, gx, dist)
+        gx -= self.gravity
+        G = np.empty(self.ny)
+        G[self.sl_x] = -gx[self.nc:].ravel()
+        G[self.sl_th] = -gth[self.ec:]
+        G[-1] = 0.0
+        e = np.diff(x, axis=0)
+        t = e / np.linalg.norm(e, axis=1)[:, None]
+        return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist)
+
+    def apply_mobility(self, y: np.ndarray, G: np.ndarray) -> np.ndarray:
+        """``Mob(y) G`` without the motor term."""
+        out = np.empty_like(G)
+        x, _, _ = self.unpack(y)
+        Fx = G[self.sl_x].reshape(-1, 3)
+        out[self.sl_x] = self.mobility.apply(x[self.nc:], Fx).ravel() / self.machin
+        out[self.sl_th] = G[self.sl_th] / (self.machin * self.rot_drag[self.ec:])
+        out[-1] = 0.0
+        return out
+
+    def rhs(self, y, base, omega):
+        info = self.forces(y, base)
+        f = self.apply_mobility(y, info.G)
+        f[-1] = omega
+        return f, info
+
+    def mobility_matrix(self, y: np.ndarray) -> np.ndarray:
+        """Dense ``Mob(y)`` (ny, ny)."""
+        x, _, _ = self.unpack(y)
+        Mob = np.zeros((self.ny, self.ny))
+        n3 = 3 * self.nb
+        Mob[:n3, :n3] = self.mobility.matrix(x[self.nc:]) / self.machin
+        idx = np.arange(n3, n3 + self.ne)
+        Mob[idx, idx] = 1.0 / (self.machin * self.rot_drag[self.ec:])
+        return Mob
+
+    # Jacobian by coloured finite differences ------------------------------------------------
+    def _build_colors(self):
+        """Groups of columns whose force stencils are disjoint (5 apart along the chain)."""
+        nb, ne, nc, ec = self.nb, self.ne, self.nc, self.ec
+        groups = []
+
+        def bead_rows(k):  # k: full bead index; rows affected: beads k-2..k+2, bonds k-2..k+1
+            rows = []
+            for m in range(k - 2, k + 3):
+                if nc <= m < self.N:
+                    rows += [3 * (m - nc) + c for c in range(3)]
+            for j in range(k - 2, k + 2):
+                if ec <= j < self.N - 1:
+                    rows.append(3 * nb + (j - ec))
+            return rows
+
+        def edge_rows(j):  # bond j: beads j-1..j+2, bonds j-1..j+1
+            rows = []
+            for m in range(j - 1, j + 3):
+                if nc <= m < self.N:
+                    rows += [3 * (m - nc) + c for c in range(3)]
+            for i in range(j - 1, j + 2):
+                if ec <= i < self.N - 1:
+                    rows.append(3 * nb + (i - ec))
+            return rows
+
+        for start in range(5):
+            for c in range(3):
+                cols, rows_l, cols_l = [], [], []
+                for k in range(nc + start, self.N, 5):
+                    col = 3 * (k - nc) + c
+                    cols.append(col)
+                    rr = bead_rows(k)
+                    rows_l += rr
+                    cols_l += [col] * len(rr)
+                if cols:
+                    groups.append((np.array(cols), np.array(rows_l), np.array(cols_l)))
+        for start in range(5):
+            cols, rows_l, cols_l = [], [], []
+            for j in range(ec + start, self.N - 1, 5):
+                col = 3 * nb + (j - ec)
+                cols.append(col)
+                rr = edge_rows(j)
+                rows_l += rr
+                cols_l += [col] * len(rr)
+            if cols:
+                groups.append((np.array(cols), np.array(rows_l), np.array(cols_l)))
+        self._colors = groups
+
+    def force_jacobian(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
+                       delta: float = 1e-7) -> np.ndarray:
+        """``dG/dy`` (ny, ny), dense, by one-sided coloured differences (~21 force calls)."""
+        if self._colors is None:
+            self._build_colors()
+        if G0 is None:
+            G0 = self.forces(y, base).G
+        J = np.zeros((self.ny, self.ny))
+        for cols, rows, cc in self._colors:
+            yp = y.copy()
+            yp[cols] += delta
+            dG = (self.forces(yp, base).G - G0) / delta
+            J[rows, cc] = dG[rows]
+        yp = y.copy()
+        yp[-1] += delta
+        J[:, -1] = (self.forces(yp, base).G - G0) / delta
+        return J
+
+    # observables ---------------------------------------------------------------------------
+    def motor_torque(self, info: ForceInfo, phi: float, omega: float) -> float:
+        """Axial torque the motor supplies [A/L], about the outward axis (positive = CCW).
+
+        Torque balance on the driven DOF: ``N_m = dE/dphi + zeta_r0 omega`` with
+        ``zeta_r0 = M 8 pi a^3 w_0`` the rotational drag of the clamped bond.
+        """
+        dEdphi = self.clamp.generalized_force(phi, info.grad_x, info.grad_theta)
+        return dEdphi + self.machin * self.rot_drag[0] * omega

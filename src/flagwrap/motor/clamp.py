@@ -1,0 +1,48 @@
+"""Boundary condition at the driven end.
+
+:class:`AxialClamp` holds the first bond (beads 0 and 1) and turns it, with its material frame,
+about the body axis by the motor angle ``phi``. The hook of a real bacterium (a universal joint)
+would be another class with the same methods.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flagwrap.geometry.frames import rotation_matrix
+
+
+class AxialClamp:
+    """Clamped first bond, rotated about ``axis`` (unit, through the origin) by ``phi``.
+
+    Attributes
+    ----------
+    n_beads : int  number of prescribed beads (2)
+    n_edges : int  number of prescribed twist angles (1)
+    """
+
+    n_beads = 2
+    n_edges = 1
+
+    def __init__(self, x0: np.ndarray, theta0: np.ndarray, axis=(0.0, 0.0, -1.0)):
+        self.axis = np.asarray(axis, float) / np.linalg.norm(axis)
+        self.x_ref = np.array(x0[: self.n_beads], float)
+        self.theta_ref = np.array(theta0[: self.n_edges], float)
+        # generators: d x_c / d phi = axis x x_c, d theta_0 / d phi = 1 (if the bond is on axis,
+        # its material frame turns about its own tangent at exactly the motor rate)
+        t0 = x0[1] - x0[0]
+        t0 = t0 / np.linalg.norm(t0)
+        self.twist_rate = float(np.dot(t0, self.axis))
+
+    def positions(self, phi: float) -> np.ndarray:
+        Rm = rotation_matrix(self.axis, phi)
+        return self.x_ref @ Rm.T
+
+    def theta(self, phi: float) -> np.ndarray:
+        return self.theta_ref + self.twist_rate * phi
+
+    def generalized_force(self, phi: float, grad_x: np.ndarray, grad_th: np.ndarray) -> float:
+        """``dE/dphi`` from the energy gradient on the clamped beads and twist angles."""
+        xc = self.positions(phi)
+        dx = np.cross(self.axis, xc)
+        return float(np.sum(dx * grad_x[: self.n_beads]) + self.twist_rate * grad_th[0])

@@ -1,0 +1,492 @@
+"""Parameters of a run: frozen dataclasses in SI units, validated on construction.
+
+Every impossible value is rejected in ``__post_init__`` with a :class:`UserInputError`
+naming the parameter and its allowed range, before any work starts. Dimensionless numbers
+(``M``, ``Re``, the estimate of ``omega/omega_c``) are derived properties, never inputs that
+could disagree with the SI values, except that the motor speed may be *given* as ``M``.
+
+Units: lengths [m], moduli [Pa], viscosity [Pa s], density [kg m^-3], frequency [Hz].
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from flagwrap import units
+from flagwrap.errors import UserInputError
+
+#: prefactor of the paper's stability line M_c = 0.06 (R/L)^-3 (main text, Fig. 5)
+PAPER_MC_PREFACTOR = 0.06
+
+
+def _finite(name: str, value) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise UserInputError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise UserInputError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def _positive(name: str, value, unit: str = "") -> float:
+    v = _finite(name, value)
+    if v <= 0:
+        raise UserInputError(f"{name} must be > 0{(' ' + unit) if unit else ''}, got {value!r}")
+    return v
+
+
+def _set(obj, name, value):
+    object.__setattr__(obj, name, value)
+
+
+@dataclass(frozen=True)
+class Filament:
+    """Elastic helical filament (the flagellum or the elastomer helix).
+
+    Give ``length``, ``helix_radius`` and exactly one of ``pitch``, ``pitch_angle_deg`` or
+    ``turns``; the others are derived (pitch angle ``psi = atan(2 pi R / P)``, measured from the
+    helix axis; ``L = n sqrt((2 pi R)^2 + P^2)``).
+
+    Attributes
+    ----------
+    length : float
+        contour length ``L`` [m].
+    helix_radius : float
+        ``R`` [m].
+    pitch : float
+        ``P`` [m].
+    cross_section_radius : float
+        ``a`` [m]; the bending modulus is ``A = pi E a^4 / 4``.
+    youngs_modulus : float
+        ``E`` [Pa].
+    poisson_ratio : float
+        ``nu`` in [-1, 0.5]; ``C = A / (1 + nu)``.
+    handedness : {"left", "right"}
+        bacterial flagella (normal and coil forms) are left-handed.
+    n_beads : int
+        number of beads ``N >= 5`` (paper: 61). Bond length ``b = L / (N - 1)``.
+    density : float or None
+        filament density [kg m^-3]; ``None`` means density-matched (no gravity).
+    hydrodynamic_radius : float or None
+        bead radius used in the mobility [m]; ``None`` means ``a`` (the paper's choice).
+    stretch_stiffness : float
+        bond spring constant in units of ``A / b^3`` (default 1000: axial strain ~ F b^2/(1000 A)).
+    """
+
+    length: float
+    helix_radius: float
+    cross_section_radius: float
+    youngs_modulus: float
+    pitch: float | None = None
+    pitch_angle_deg: float | None = None
+    turns: float | None = None
+    poisson_ratio: float = 0.49
+    handedness: str = "left"
+    n_beads: int = 61
+    density: float | None = None
+    hydrodynamic_radius: float | None = None
+    stretch_stiffness: float = 1000.0
+
+    def __post_init__(self):
+        L = _positive("filament.length", self.length, "m")
+        R = _positive("filament.helix_radius", self.helix_radius, "m")
+        a = _positive("filament.cross_section_radius", self.cross_section_radius, "m")
+        _positive("filament.youngs_modulus", self.youngs_modulus, "Pa")
+        given = [k for k in ("pitch", "pitch_angle_deg", "turns") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise UserInputError(
+                "filament: give exactly one of pitch, pitch_angle_deg or turns "
+                f"(got {', '.join(given) if given else 'none'})"
+            )
+        if given[0] == "pitch":
+            P = _positive("filament.pitch", self.pitch, "m")
+        elif given[0] == "pitch_angle_deg":
+            psi = _finite("filament.pitch_angle_deg", self.pitch_angle_deg)
+            if not 0.0 < psi < 90.0:
+                raise UserInputError(f"filament.pitch_angle_deg must be in (0, 90) deg, got {psi}")
+            P = 2 * math.pi * R / math.tan(math.radians(psi))
+        else:
+            n = _positive("filament.turns", self.turns)
+            per_turn = L / n
+            if per_turn <= 2 * math.pi * R:
+                raise UserInputError(
+                    f"filament.turns={n} needs a contour per turn L/n={per_turn:g} m longer than "
+                    f"2 pi R={2 * math.pi * R:g} m; allowed: turns < {L / (2 * math.pi * R):g}"
+                )
+            P = math.sqrt(per_turn**2 - (2 * math.pi * R) ** 2)
+        _set(self, "pitch", P)
+        _set(self, "pitch_angle_deg", math.degrees(math.atan2(2 * math.pi * R, P)))
+        _set(self, "turns", L / math.hypot(2 * math.pi * R, P))
+        if a >= R:
+            raise UserInputError(
+                f"filament.cross_section_radius={a:g} m must be < helix_radius={R:g} m"
+            )
+        if P <= 2 * a:
+            raise UserInputError(
+                f"filament.pitch={P:g} m must be > 2 * cross_section_radius={2 * a:g} m "
+                "(otherwise successive turns overlap)"
+            )
+        nu = _finite("filament.poisson_ratio", self.poisson_ratio)
+        if not -1.0 < nu <= 0.5:
+            raise UserInputError(f"filament.poisson_ratio must be in (-1, 0.5], got {nu}")
+        if self.handedness not in ("left", "right"):
+            raise UserInputError(
+                f"filament.handedness must be 'left' or 'right', got {self.handedness!r}"
+            )
+        if isinstance(self.n_beads, bool) or not isinstance(self.n_beads, (int, np.integer)):
+            raise UserInputError(f"filament.n_beads must be an integer, got {self.n_beads!r}")
+        if not 5 <= self.n_beads <= 200_000:
+            raise UserInputError(f"filament.n_beads must be in [5, 200000], got {self.n_beads}")
+        if self.density is not None:
+            _positive("filament.density", self.density, "kg/m^3")
+        if self.hydrodynamic_radius is not None:
+            ah = _positive("filament.hydrodynamic_radius", self.hydrodynamic_radius, "m")
+            if ah >= R:
+                raise UserInputError(
+                    f"filament.hydrodynamic_radius={ah:g} m must be < helix_radius={R:g} m"
+                )
+        _positive("filament.stretch_stiffness", self.stretch_stiffness, "(units of A/b^3)")
+        if L <= 2 * a:
+            raise UserInputError(f"filament.length={L:g} m must exceed 2 a = {2 * a:g} m")
+
+    # derived -------------------------------------------------------------------------------
+    @property
+    def bending_modulus(self) -> float:
+        """``A = pi E a^4 / 4`` [N m^2]."""
+        return units.bending_modulus(self.youngs_modulus, self.cross_section_radius)
+
+    @property
+    def twist_modulus(self) -> float:
+        """``C = A / (1 + nu)`` [N m^2]."""
+        return units.twist_modulus(self.bending_modulus, self.poisson_ratio)
+
+    @property
+    def bond_length(self) -> float:
+        """``b = L / (N - 1)`` [m]."""
+        return self.length / (self.n_beads - 1)
+
+    @property
+    def bead_radius(self) -> float:
+        """Hydrodynamic bead radius [m]."""
+        return self.hydrodynamic_radius or self.cross_section_radius
+
+    @property
+    def curvature0(self) -> float:
+        """Spontaneous curvature ``kappa0 = 4 pi^2 R / (P^2 + 4 pi^2 R^2)`` [1/m] (SI)."""
+        R, P = self.helix_radius, self.pitch
+        return 4 * math.pi**2 * R / (P**2 + 4 * math.pi**2 * R**2)
+
+    @property
+    def torsion0(self) -> float:
+        """Spontaneous torsion ``tau0 = 2 pi P / (P^2 + 4 pi^2 R^2)`` [1/m], >0 (SI; sign by handedness)."""
+        R, P = self.helix_radius, self.pitch
+        return 2 * math.pi * P / (P**2 + 4 * math.pi**2 * R**2)
+
+
+@dataclass(frozen=True)
+class Fluid:
+    """Newtonian fluid. Defaults: the paper's glycerin (eta = 1.1 Pa s, rho = 1250 kg/m^3)."""
+
+    viscosity: float = 1.1
+    density: float = 1250.0
+
+    def __post_init__(self):
+        _positive("fluid.viscosity", self.viscosity, "Pa s")
+        d = _finite("fluid.density", self.density)
+        if d < 0:
+            raise UserInputError(f"fluid.density must be >= 0 kg/m^3, got {d}")
+
+
+@dataclass(frozen=True)
+class CellBody:
+    """Rigid cell body: a cylinder of radius ``R_cell`` capped below by a hemisphere.
+
+    Give either ``radius`` [m] or ``radius_ratio = R / R_cell`` (default 0.6, the paper's coil
+    helices: SI Fig. S7). ``cylinder_length`` [m] defaults to ``5 R_cell`` (the experiment's
+    25 cm cylinder of 5 cm radius). The fluid passes through the body (paper, Methods); only a
+    short-ranged repulsion keeps beads outside. ``enabled = false`` removes it altogether.
+    """
+
+    radius: float | None = None
+    radius_ratio: float | None = 0.6
+    cylinder_length: float | None = None
+    enabled: bool = True
+
+    def __post_init__(self):
+        if self.radius is not None:
+            _positive("body.radius", self.radius, "m")
+            _set(self, "radius_ratio", None)
+        elif self.radius_ratio is not None:
+            _positive("body.radius_ratio", self.radius_ratio)
+        else:
+            raise UserInputError("body: give radius or radius_ratio")
+        if self.cylinder_length is not None:
+            _positive("body.cylinder_length", self.cylinder_length, "m")
+        if not isinstance(self.enabled, bool):
+            raise UserInputError(f"body.enabled must be true or false, got {self.enabled!r}")
+
+    def resolved_radius(self, helix_radius: float) -> float:
+        return self.radius if self.radius is not None else helix_radius / self.radius_ratio
+
+    def resolved_length(self, helix_radius: float) -> float:
+        if self.cylinder_length is not None:
+            return self.cylinder_length
+        return 5.0 * self.resolved_radius(helix_radius)
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One phase of the motor protocol: ``turns`` turns in ``direction`` at ``speed`` x omega.
+
+    ``direction`` is seen from the free end of the filament, as in the paper: "ccw" is the
+    swimming direction of a bacterium, "cw" the reversal that triggers wrapping.
+    """
+
+    direction: str
+    turns: float
+    speed: float = 1.0
+
+    def __post_init__(self):
+        if self.direction not in ("ccw", "cw", "stop"):
+            raise UserInputError(
+                f"motor.protocol direction must be 'ccw', 'cw' or 'stop', got {self.direction!r}"
+            )
+        _positive("motor.protocol turns", self.turns)
+        _positive("motor.protocol speed", self.speed)
+
+
+def paper_protocol(ccw_turns: float = 10.0, cw_turns: float = 10.0) -> tuple[Phase, ...]:
+    """The paper's protocol: 10 CCW turns to equilibrate, then CW at the same speed."""
+    return (Phase("ccw", ccw_turns), Phase("cw", cw_turns))
+
+
+@dataclass(frozen=True)
+class Motor:
+    """Motor speed and protocol.
+
+    Give the reference speed (the CW phase's) as ``frequency`` [Hz] or as the Machin number
+    ``machin`` = eta omega L^4 / A. ``protocol`` is a sequence of :class:`Phase`; ``duration``
+    of a ``stop`` phase is given in reference turns.
+    """
+
+    frequency: float | None = None
+    machin: float | None = None
+    protocol: tuple[Phase, ...] = field(default_factory=paper_protocol)
+
+    def __post_init__(self):
+        if (self.frequency is None) == (self.machin is None):
+            raise UserInputError("motor: give exactly one of frequency (Hz) or machin (M)")
+        if self.frequency is not None:
+            _positive("motor.frequency", self.frequency, "Hz")
+        else:
+            _positive("motor.machin", self.machin)
+        prot = tuple(p if isinstance(p, Phase) else Phase(**p) for p in self.protocol)
+        if not prot:
+            raise UserInputError("motor.protocol must have at least one phase")
+        _set(self, "protocol", prot)
+
+
+@dataclass(frozen=True)
+class Clamp:
+    """Shape of the rod next to the vertically clamped driving end (not printed in the paper).
+
+    ``lead = "ramp"`` (default): the helix axis is the body axis (issue spec); from the vertical
+    clamped bond the helix radius ramps smoothly from 0 to ``R`` over ``lead_turns`` helical turns
+    (``r = R (1 - cos(pi phi / phi_r)) / 2``), so the centreline and its tangent are continuous.
+    ``lead = "kink"``: a uniform helix from bead 1 on, whose axis is parallel to the body axis at
+    distance ``R`` (it passes through the clamp), with a kink of angle ``psi`` at bead 1.
+    In both cases the initial shape is stress-free. See docs/model.md for their effect.
+    """
+
+    lead: str = "ramp"
+    lead_turns: float = 0.5
+
+    def __post_init__(self):
+        if self.lead not in ("ramp", "kink"):
+            raise UserInputError(f"clamp.lead must be 'ramp' or 'kink', got {self.lead!r}")
+        lt = _finite("clamp.lead_turns", self.lead_turns)
+        if not 0.0 < lt <= 5.0:
+            raise UserInputError(f"clamp.lead_turns must be in (0, 5], got {lt}")
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Short-ranged repulsion between beads and the cell body (WCA form).
+
+    ``range`` is the cut-off gap in units of the cross-section radius ``a`` (the potential acts
+    when the bead centre is closer than ``a * (1 + range)`` to the body surface); ``strength``
+    is the energy scale in units of ``A / b``.
+    """
+
+    range: float = 1.0
+    strength: float = 1.0
+
+    def __post_init__(self):
+        _positive("contact.range", self.range, "(units of a)")
+        _positive("contact.strength", self.strength, "(units of A/b)")
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """How to integrate.
+
+    Attributes
+    ----------
+    integrator : {"rosenbrock", "euler"}
+        "rosenbrock": adaptive, L-stable, linearly implicit 2nd-order ROS2 (default);
+        "euler": the paper-style explicit Euler reference (fixed ``dt``).
+    hydrodynamics : bool
+        long-range Rotne-Prager-Yamakawa interactions on (True) or self mobility only.
+    dt : float
+        first (rosenbrock) or fixed (euler) step, in motor turns ``T``.
+    tol : float
+        local error tolerance per step (positions in units of L; twist angles allowed 10x).
+        The default 1e-4 keeps the global error of the free end below ~1e-2 L per turn; 1e-3 is
+        visibly wrong (it can trigger a spurious CCW instability, see docs/numerics.md).
+    threads : int
+        BLAS threads for the dense linear algebra of one run (1 is fastest at N ~ 60 and lets
+        sweeps run one case per core).
+    dt_min : float
+        smallest step [turns] before the run is declared stuck.
+    save_every : float
+        output interval [turns].
+    max_steps : int
+        hard cap on the number of steps.
+    """
+
+    integrator: str = "rosenbrock"
+    hydrodynamics: bool = True
+    dt: float = 1e-3
+    tol: float = 1e-4
+    dt_min: float = 1e-12
+    save_every: float = 0.05
+    max_steps: int = 50_000_000
+    threads: int = 1
+
+    def __post_init__(self):
+        if self.integrator not in ("rosenbrock", "euler"):
+            raise UserInputError(
+                f"numerics.integrator must be 'rosenbrock' or 'euler', got {self.integrator!r}"
+            )
+        if not isinstance(self.hydrodynamics, bool):
+            raise UserInputError(
+                f"numerics.hydrodynamics must be true or false, got {self.hydrodynamics!r}"
+            )
+        dt = _positive("numerics.dt", self.dt, "turns")
+        if dt > 0.5:
+            raise UserInputError(f"numerics.dt must be <= 0.5 turns, got {dt}")
+        tol = _positive("numerics.tol", self.tol)
+        if tol > 0.1:
+            raise UserInputError(f"numerics.tol must be in (0, 0.1], got {tol}")
+        _positive("numerics.dt_min", self.dt_min, "turns")
+        _positive("numerics.save_every", self.save_every, "turns")
+        if isinstance(self.max_steps, bool) or not isinstance(self.max_steps, (int, np.integer)):
+            raise UserInputError(f"numerics.max_steps must be an integer, got {self.max_steps!r}")
+        if self.max_steps < 1:
+            raise UserInputError(f"numerics.max_steps must be >= 1, got {self.max_steps}")
+        if isinstance(self.threads, bool) or not isinstance(self.threads, (int, np.integer)) \
+                or not 1 <= self.threads <= 256:
+            raise UserInputError(f"numerics.threads must be an integer in [1, 256], got {self.threads!r}")
+
+
+@dataclass(frozen=True)
+class Config:
+    """Everything that defines one run."""
+
+    filament: Filament
+    motor: Motor
+    fluid: Fluid = field(default_factory=Fluid)
+    body: CellBody = field(default_factory=CellBody)
+    contact: Contact = field(default_factory=Contact)
+    numerics: Numerics = field(default_factory=Numerics)
+    clamp: Clamp = field(default_factory=Clamp)
+    name: str = "run"
+
+    def __post_init__(self):
+        for attr, cls in (
+            ("filament", Filament),
+            ("motor", Motor),
+            ("fluid", Fluid),
+            ("body", CellBody),
+            ("contact", Contact),
+            ("numerics", Numerics),
+            ("clamp", Clamp),
+        ):
+            if not isinstance(getattr(self, attr), cls):
+                raise UserInputError(f"config.{attr} must be a {cls.__name__}")
+        fil = self.filament
+        # beads that are not contour neighbours must not overlap in the stress-free helix
+        from flagwrap.geometry.helix import min_nonlocal_distance
+
+        dmin = min_nonlocal_distance(fil, self.clamp)
+        if dmin < 2 * fil.cross_section_radius:
+            raise UserInputError(
+                f"initial helix self-overlaps: two non-neighbouring beads are {dmin:g} m apart, "
+                f"less than 2 a = {2 * fil.cross_section_radius:g} m (increase pitch or reduce a)"
+            )
+
+    # derived dimensionless numbers -------------------------------------------------------------
+    @property
+    def omega(self) -> float:
+        """Reference motor angular speed [rad/s]."""
+        if self.motor.frequency is not None:
+            return 2 * math.pi * self.motor.frequency
+        fil = self.filament
+        return self.motor.machin * fil.bending_modulus / (self.fluid.viscosity * fil.length**4)
+
+    @property
+    def scales(self) -> units.Scales:
+        return units.Scales(
+            length=self.filament.length,
+            omega=self.omega,
+            bending=self.filament.bending_modulus,
+            viscosity=self.fluid.viscosity,
+        )
+
+    @property
+    def machin(self) -> float:
+        """``M = eta omega L^4 / A``."""
+        return self.scales.machin
+
+    @property
+    def reynolds(self) -> float:
+        """``Re = rho R^2 omega / eta``."""
+        return units.reynolds_number(
+            self.fluid.density, self.filament.helix_radius, self.omega, self.fluid.viscosity
+        )
+
+    @property
+    def machin_critical_scaling(self) -> float:
+        """Scaling estimate ``M_c = 0.06 (R/L)^-3`` of the paper's Fig. 5 (not a simulation result)."""
+        return PAPER_MC_PREFACTOR * (self.filament.helix_radius / self.filament.length) ** -3
+
+    @property
+    def omega_ratio_scaling(self) -> float:
+        """``omega / omega_c`` estimated from the scaling line, ``M / M_c``."""
+        return self.machin / self.machin_critical_scaling
+
+    def replace(self, **changes) -> "Config":
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        """Plain nested dict (JSON/TOML-able); ``None`` values are dropped."""
+
+        def clean(obj):
+            if dataclasses.is_dataclass(obj):
+                return {k: clean(v) for k, v in dataclasses.asdict(obj).items() if v is not None}
+            if isinstance(obj, dict):
+                return {k: clean(v) for k, v in obj.items() if v is not None}
+            if isinstance(obj, (list, tuple)):
+                return [clean(v) for v in obj]
+            return obj
+
+        d = clean(self)
+        # pitch-like inputs are all stored after resolution; keep only pitch (canonical)
+        d["filament"].pop("pitch_angle_deg", None)
+        d["filament"].pop("turns", None)
+        return d

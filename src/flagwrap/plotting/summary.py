@@ -1,0 +1,44 @@
+"""Summary figure of one run: free-end height and motor torque against t/T."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def summary_figure(ds, path):
+    """Two panels: ``(z(L) - z(0))/L`` and ``N_m R / A`` against ``t/T`` (paper Fig. 4(c),(d))."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    turns = ds["turns"].values
+    L = ds.attrs["length"]
+    z = (ds["position"].values[:, -1, 2] - ds["position"].values[:, 0, 2]) / L
+    tq = ds["motor_torque_reduced"].values
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
+    a1.plot(turns, z, color="C0")
+    a1.axhline(0, color="0.6", lw=0.8, ls="--")
+    a1.set_ylabel(r"$[z(L)-z(0)]/L$")
+    a2.plot(turns, tq, color="C3")
+    a2.set_ylabel(r"$N_m R/A$ (CCW > 0)")
+    a2.set_xlabel(r"$t/T$")
+    for t_sw in _switch_turns(ds):
+        for ax in (a1, a2):
+            ax.axvline(t_sw, color="0.5", lw=0.8, ls=":")
+    hi = "with HI" if ds.attrs.get("hydrodynamics", 1) else "without HI"
+    a1.set_title(f"{ds.attrs.get('title', '')}: M = {ds.attrs['machin']:.4g}, {hi}")
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+    return path
+
+
+def _switch_turns(ds):
+    import numpy as np
+
+    om = np.sign(ds["omega"].values)
+    idx = np.nonzero(np.diff(om) != 0)[0]
+    return [float(ds["turns"].values[i + 1]) for i in idx]

@@ -1,0 +1,192 @@
+"""The time loop: one small object that steps, records, guards and reports progress.
+
+``simulate(config)`` -> :class:`Trajectory` (core units inside, SI on output via
+:mod:`flagwrap.io.runfile`). The loop walks through the motor protocol phase by phase (so the
+right-hand side is smooth inside every step), clips steps to land on output times, and stops
+with a message, keeping everything computed so far, when a guard trips:
+
+* a non-finite state or a step size below ``numerics.dt_min``;
+* a bead inside the cell body;
+* a bond strain above ``max_strain`` (the springs are meant to be virtually inextensible).
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from flagwrap.integrators import make_integrator
+from flagwrap.model import RodSystem
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass
+class Trajectory:
+    """Recorded run in core units (length L, time 1/omega, torque A/L)."""
+
+    config: object
+    t: list = field(default_factory=list)
+    x: list = field(default_factory=list)
+    theta: list = field(default_factory=list)
+    m1: list = field(default_factory=list)
+    phi: list = field(default_factory=list)
+    omega: list = field(default_factory=list)
+    motor_torque: list = field(default_factory=list)
+    elastic_energy: list = field(default_factory=list)
+    contact_energy: list = field(default_factory=list)
+    min_distance: list = field(default_factory=list)
+    max_strain: list = field(default_factory=list)
+    status: str = "running"
+    message: str = ""
+    n_steps: int = 0
+    n_rejected: int = 0
+    wall_time: float = 0.0
+    final_frames: object = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "completed"
+
+    def arrays(self) -> dict:
+        return {k: np.asarray(getattr(self, k)) for k in (
+            "t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
+            "contact_energy", "min_distance", "max_strain")}
+
+
+class Simulation:
+    """Owns the loop for one :class:`RodSystem` and one integrator."""
+
+    def __init__(self, config, system: RodSystem | None = None, integrator=None,
+                 max_strain: float = 0.05):
+        self.config = config
+        self.system = system or RodSystem(config)
+        num = config.numerics
+        self.integrator = integrator or make_integrator(num.integrator, num.tol)
+        self.h0 = num.dt * TWO_PI
+        self.h_min = num.dt_min * TWO_PI
+        self.save_dt = num.save_every * TWO_PI
+        self.max_steps = num.max_steps
+        self.max_strain_limit = max_strain
+
+    def _record(self, traj, t, y, info, omega):
+        s = self.system
+        traj.t.append(t)
+        traj.x.append(info.x.copy())
+        traj.theta.append(info.theta.copy())
+        m1 = np.empty((s.N - 1, 3))
+        m2 = np.empty((s.N - 1, 3))
+        from flagwrap.elasticity._kernels import material_frames
+
+        material_frames(info.frames.t, info.frames.d1, info.theta, m1, m2)
+        traj.m1.append(m1)
+        traj.phi.append(y[-1])
+        traj.omega.append(omega)
+        traj.motor_torque.append(s.motor_torque(info, y[-1], omega))
+        traj.elastic_energy.append(info.elastic_energy)
+        traj.contact_energy.append(info.contact_energy)
+        traj.min_distance.append(float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf)
+        traj.max_strain.append(self._strain(info))
+
+    def _strain(self, info) -> float:
+        ln = np.linalg.norm(np.diff(info.x, axis=0), axis=1)
+        return float(np.max(np.abs(ln / self.system.rest.l0 - 1.0)))
+
+    def _guard(self, info) -> str:
+        s = self.system
+        if s.N > s.nc and np.min(info.distance[s.nc:]) <= 0.0:
+            i = int(np.argmin(info.distance[s.nc:])) + s.nc
+            return f"bead {i} entered the cell body (distance {info.distance[i]:.3g} L)"
+        strain = np.abs(np.linalg.norm(np.diff(info.x, axis=0), axis=1) / s.rest.l0 - 1.0)
+        if strain.max() > self.max_strain_limit:
+            j = int(np.argmax(strain))
+            return (f"bond {j} strain {strain[j]:.3g} exceeds the limit {self.max_strain_limit:g} "
+                    "(stretching springs no longer inextensible)")
+        return ""
+
+    def run(self, t_end: float | None = None, progress: bool = False, y0=None,
+            base=None, t0: float = 0.0) -> Trajectory:
+        s = self.system
+        sched = s.schedule
+        t_end = sched.t_end if t_end is None else t_end
+        traj = Trajectory(self.config)
+        y = s.initial_y() if y0 is None else np.array(y0, float)
+        base = (s.frames0.copy() if base is None else base)
+        info = s.forces(y, base)
+        base = info.frames
+        t = t0
+        h = self.h0
+        self._record(traj, t, y, info, sched(t))
+        next_save = t + self.save_dt
+        bar = None
+        if progress:
+            from tqdm.auto import tqdm
+
+            bar = tqdm(total=round((t_end - t0) / TWO_PI, 3), unit="turn", desc=self.config.name,
+                       bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} turns [{elapsed}<{remaining}]")
+        start = _time.perf_counter()
+        fixed = not self.integrator.adaptive
+        eps = 1e-12 * max(1.0, t_end)
+        try:
+            while t < t_end - eps:
+                k = sched.segment_index(t + eps)
+                seg = sched.segments[k]
+                omega = seg.omega
+                stop_at = min(seg.t1, t_end, next_save)
+                h_try = min(h, stop_at - t)
+                res = self.integrator.step(s, y, base, info, h_try, omega)
+                if not res.accepted:
+                    traj.n_rejected += 1
+                    if fixed:
+                        raise _Stop(f"t/T={t / TWO_PI:.6g}: {res.reason} with fixed dt={h_try / TWO_PI:.3g} T")
+                    h = res.h_next
+                    if h < self.h_min:
+                        raise _Stop(f"t/T={t / TWO_PI:.6g}: step size {h / TWO_PI:.3g} T fell below "
+                                    f"dt_min={self.h_min / TWO_PI:.3g} T ({res.reason})")
+                    continue
+                traj.n_steps += 1
+                t_new = t + h_try
+                y, info = res.y, res.info
+                base = info.frames
+                msg = self._guard(info)
+                if msg:
+                    self._record(traj, t_new, y, info, omega)
+                    raise _Stop(f"t/T={t_new / TWO_PI:.6g}: {msg}")
+                if not fixed:
+                    # do not let a step clipped to an output time shrink the controller's step
+                    h = res.h_next if h_try >= h * 0.999 else max(h, res.h_next)
+                if bar is not None:
+                    bar.update(round((t_new - t) / TWO_PI, 6))
+                t = t_new
+                if t >= next_save - eps:
+                    self._record(traj, t, y, info, omega)
+                    next_save += self.save_dt
+                if traj.n_steps >= self.max_steps:
+                    raise _Stop(f"t/T={t / TWO_PI:.6g}: reached numerics.max_steps={self.max_steps}")
+            if traj.t[-1] < t - eps:
+                self._record(traj, t, y, info, sched(t - eps))
+            traj.status = "completed"
+        except _Stop as stop:
+            traj.status = "failed"
+            traj.message = str(stop)
+        finally:
+            if bar is not None:
+                bar.close()
+            traj.wall_time = _time.perf_counter() - start
+            traj.final_frames = base
+        return traj
+
+
+class _Stop(Exception):
+    pass
+
+
+def simulate(config, progress: bool = False, **kwargs) -> Trajectory:
+    """Run ``config`` through its whole motor protocol; see :class:`Simulation`."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=config.numerics.threads):
+        return Simulation(config, **kwargs).run(progress=progress)
