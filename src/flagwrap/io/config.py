@@ -77,9 +77,6 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
     for key in data:
         if key not in allowed_top:
             raise UserInputError(f"unknown section or key {key!r}; allowed: {', '.join(sorted(allowed_top))}")
-    for req in ("filament", "motor"):
-        if req not in data:
-            raise UserInputError(f"missing required section [{req}]")
     u = data.pop("units", {}) or {}
     if not isinstance(u, dict):
         raise UserInputError("[units] must be a table")
@@ -90,6 +87,9 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
     pf = _unit(u, "pressure", _PRESSURE, "Pa")
     vf = _unit(u, "viscosity", _VISCOSITY, "Pa s")
     df = _unit(u, "density", _DENSITY, "kg/m3")
+    for req in ("filament", "motor"):
+        if req not in data:
+            raise UserInputError(f"missing required section [{req}]")
     kwargs = {}
     for section, cls in _SECTIONS.items():
         table = data.get(section, {})

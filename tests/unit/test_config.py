@@ -1,0 +1,58 @@
+"""TOML configs: round trip and clean errors."""
+
+import pytest
+
+from flagwrap.errors import UserInputError
+from flagwrap.io.config import config_from_dict, config_to_toml, load_config
+
+
+def test_examples_load_and_round_trip(tmp_path):
+    import glob
+
+    files = sorted(glob.glob("examples/*.toml"))
+    assert len(files) >= 7
+    for f in files:
+        cfg = load_config(f)
+        p = tmp_path / "c.toml"
+        p.write_text(config_to_toml(cfg))
+        again = load_config(p)
+        assert again.to_dict() == {**cfg.to_dict(), "name": cfg.name}
+
+
+def test_unit_table_rescales():
+    d = {
+        "units": {"length": "mm", "pressure": "MPa"},
+        "filament": {"length": 400, "helix_radius": 30, "turns": 2, "cross_section_radius": 1.5,
+                     "youngs_modulus": 1.5},
+        "motor": {"machin": 283},
+    }
+    cfg = config_from_dict(d)
+    assert cfg.filament.length == pytest.approx(0.4)
+    assert cfg.filament.youngs_modulus == pytest.approx(1.5e6)
+
+
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ("[filament]\nlenght = 1\n[motor]\nmachin=1", "unknown key filament.lenght"),
+        ("[filament\n", "malformed TOML"),
+        ("[motor]\nmachin = 10\n", "missing required section \\[filament\\]"),
+        ("[filament]\nlength = 0.4\n[motor]\nmachin = 10\n", "missing required value"),
+        ("[filament]\nlength = 'long'\nhelix_radius=0.03\nturns=2\ncross_section_radius=0.0015\n"
+         "youngs_modulus=1.5e6\n[motor]\nmachin = 10\n", "filament.length must be a number"),
+        ("[filament]\nlength = inf\nhelix_radius=0.03\nturns=2\ncross_section_radius=0.0015\n"
+         "youngs_modulus=1.5e6\n[motor]\nmachin = 10\n", "finite"),
+        ("[bogus]\n", "unknown section"),
+        ("[units]\nlength='furlong'\n", "units.length"),
+    ],
+)
+def test_bad_configs_give_one_line_errors(tmp_path, text, needle):
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(UserInputError, match=needle):
+        load_config(p)
+
+
+def test_missing_file():
+    with pytest.raises(UserInputError, match="not found"):
+        load_config("does/not/exist.toml")
