@@ -295,15 +295,21 @@ class Motor:
 class Clamp:
     """Shape of the rod next to the vertically clamped driving end (not printed in the paper).
 
-    ``lead = "ramp"`` (default): the helix axis is the body axis (issue spec); from the vertical
-    clamped bond the helix radius ramps smoothly from 0 to ``R`` over ``lead_turns`` helical turns
-    (``r = R (1 - cos(pi phi / phi_r)) / 2``), so the centreline and its tangent are continuous.
-    ``lead = "kink"``: a uniform helix from bead 1 on, whose axis is parallel to the body axis at
-    distance ``R`` (it passes through the clamp), with a kink of angle ``psi`` at bead 1.
-    In both cases the initial shape is stress-free. See docs/model.md for their effect.
+    ``lead = "kink"`` (default): the clamped first bond points straight down the body axis
+    ("vertically clamped", paper Discussion) and from bead 1 on the filament is the uniform
+    stress-free helix, whose axis is therefore parallel to the body axis at distance ``R`` (a
+    uniform helix held by its end on the axis cannot be centred on it without an extra lead).
+    The angle ``psi`` between the clamped bond and the helix is part of the stress-free shape.
+    Turning the clamp makes the helix whirl about the body axis, as in the paper's stable runs.
+
+    ``lead = "ramp"``: the helix axis is the body axis; from the vertical clamped bond the helix
+    radius ramps smoothly from 0 to ``R`` over ``lead_turns`` helical turns
+    (``r = R (1 - cos(pi phi / phi_r)) / 2``). The centreline and its tangent are continuous.
+
+    Both initial shapes are stress-free. docs/model.md measures how results move between them.
     """
 
-    lead: str = "ramp"
+    lead: str = "kink"
     lead_turns: float = 0.5
 
     def __post_init__(self):

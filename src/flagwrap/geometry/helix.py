@@ -112,8 +112,8 @@ def ramp_helix_positions(length, helix_radius, pitch, n_beads, handedness="left"
 
 def filament_positions(fil, clamp=None) -> np.ndarray:
     """Initial positions [m] of a :class:`flagwrap.params.Filament` with a clamp lead."""
-    if clamp is None or clamp.lead == "ramp":
-        lt = 0.5 if clamp is None else clamp.lead_turns
+    if clamp is not None and clamp.lead == "ramp":
+        lt = clamp.lead_turns
         return ramp_helix_positions(fil.length, fil.helix_radius, fil.pitch, fil.n_beads,
                                     fil.handedness, lt)
     return helix_positions(fil.length, fil.helix_radius, fil.pitch, fil.n_beads, fil.handedness)
