@@ -21,6 +21,9 @@ COMMANDS: dict[str, str] = {
     "viscosity": "viscosity",
     "density": "density",
     "bacteria": "bacteria",
+    "snapshots": "snapshots",
+    "movie": "movie",
+    "export-vtk": "export_vtk",
 }
 
 

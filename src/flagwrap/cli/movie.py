@@ -1,0 +1,56 @@
+"""Render a movie of a run: two camera views, clock, motor direction, live tip height and torque.
+
+Frame k shows t_k = t_0 + k * speed / fps; n_frames = floor((t_end - t_0) fps / speed) + 1.
+``--speed auto`` (default) gives one movie frame per saved frame. MP4 via imageio-ffmpeg, GIF
+if ffmpeg is missing or the output ends in .gif.
+
+Examples::
+
+    flagwrap movie out/fig4a.nc -o fig4a.mp4 --speed 100x --fps 25
+"""
+
+from __future__ import annotations
+
+
+def add_arguments(p):
+    p.add_argument("run_file", help="run file (.nc) written by `flagwrap run`")
+    p.add_argument("-o", "--output", help="movie file (.mp4 or .gif); default RUN.mp4 beside the run")
+    p.add_argument("--fps", type=float, default=25.0, help="frames per second (25)")
+    p.add_argument("--speed", default="auto",
+                   help="replay speed, physical seconds per movie second, e.g. 100x (default auto: "
+                        "one frame per saved frame)")
+    p.add_argument("--size", default="1024x576", help="frame size WxH in pixels, multiples of 16")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from flagwrap.io.runfile import read_run
+    from flagwrap.plotting.movies import (movie_times, parse_size, parse_speed,
+                                          write_movie)
+
+    ds = read_run(args.run_file)
+    out = Path(args.output) if args.output else Path(args.run_file).with_suffix(".mp4")
+    speed = parse_speed(args.speed)
+    size = parse_size(args.size)
+    n = len(movie_times(ds["time"].values, args.fps, speed))
+    bar = None
+    if not args.quiet:
+        from tqdm import tqdm
+
+        bar = tqdm(total=n, unit="frame", desc=f"movie {out.name}")
+
+    def progress(k, total):
+        if bar is not None:
+            bar.update(1)
+
+    try:
+        path = write_movie(ds, out, fps=args.fps, speed=speed, size=size, progress=progress)
+    finally:
+        if bar is not None:
+            bar.close()
+    if path.suffix != out.suffix:
+        print(f"ffmpeg unavailable: wrote a GIF instead of {out.suffix}")
+    print(f"{path}: {n} frames of {size[0]}x{size[1]} at {args.fps:g} fps")
+    return 0

@@ -1,0 +1,136 @@
+"""Snapshot strips of a run: the two camera views at chosen times (paper Fig. 4(a),(b)).
+
+Rows are the two cameras of the experiment (:data:`flagwrap.plotting.render.CAMERAS`),
+columns the chosen times ``t/T``; every panel has the same axes limits and scale, so the
+shapes can be compared across time and between views. See :mod:`flagwrap.plotting.render`
+for how the tube and the semi-transparent body are drawn.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from flagwrap.errors import UserInputError
+
+
+def cw_phase(ds):
+    """``(t/T)`` range ``(start, end)`` of the first clockwise phase of the motor, or ``None``.
+
+    CW means ``omega < 0`` (CCW seen from the free end is positive). The phase starts at the
+    last saved frame before the motor turns CW (the switch itself).
+    """
+    om = ds["omega"].values
+    turns = ds["turns"].values
+    cw = np.nonzero(om < 0)[0]
+    if not len(cw):
+        return None
+    i0 = cw[0]
+    stop = np.nonzero(om[i0:] >= 0)[0]
+    i1 = i0 + stop[0] - 1 if len(stop) else len(om) - 1
+    return float(turns[max(i0 - 1, 0)]), float(turns[i1])
+
+
+def default_times(ds, n: int = 6) -> np.ndarray:
+    """``n`` times ``t/T`` evenly spread over the CW phase (over the whole run if none)."""
+    if n < 1:
+        raise UserInputError(f"need at least one snapshot, got {n}")
+    span = cw_phase(ds)
+    turns = ds["turns"].values
+    lo, hi = span if span else (float(turns[0]), float(turns[-1]))
+    return np.linspace(lo, hi, n)
+
+
+def frame_indices(ds, times) -> np.ndarray:
+    """Indices of the saved frames nearest to the requested ``t/T`` values.
+
+    Raises :class:`UserInputError` for a time outside the run (beyond half a save interval).
+    """
+    turns = ds["turns"].values
+    times = np.atleast_1d(np.asarray(times, float))
+    tol = 0.5 * float(np.median(np.diff(turns))) if len(turns) > 1 else 0.0
+    bad = times[(times < turns[0] - tol) | (times > turns[-1] + tol)]
+    if len(bad):
+        raise UserInputError(
+            f"snapshot time(s) t/T = {', '.join(f'{b:g}' for b in bad)} outside the run "
+            f"[{turns[0]:g}, {turns[-1]:g}]"
+        )
+    return np.abs(turns[None, :] - times[:, None]).argmin(axis=1)
+
+
+def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title: str | None = None,
+                    renderer_kwargs: dict | None = None):
+    """Figure of the snapshot strip: 2 rows (cameras) x ``len(times)`` columns.
+
+    Parameters
+    ----------
+    ds : run dataset (:func:`flagwrap.io.runfile.read_run`)
+    times : t/T values; default :func:`default_times` (``n`` over the CW phase)
+    panel_width : width of one panel [inch]
+    title : figure title; default names the run and its Machin number
+
+    Returns
+    -------
+    fig : matplotlib Figure (caller saves and closes it)
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flagwrap.plotting.render import (CAMERAS, Renderer, nice_scale_bar, scene_of,
+                                          style_view, view_limits)
+
+    times = default_times(ds, n) if times is None else np.atleast_1d(np.asarray(times, float))
+    idx = frame_indices(ds, times)
+    X = ds["position"].values
+    turns = ds["turns"].values
+    om = ds["omega"].values
+    scene = scene_of(ds)
+    ulim, zlim = view_limits(X[idx], scene)
+    aspect = (zlim[1] - zlim[0]) / (ulim[1] - ulim[0])
+    ncol = len(idx)
+    fig, axes = plt.subplots(2, ncol, figsize=(panel_width * ncol + 0.4, 2 * panel_width * aspect + 0.8),
+                             squeeze=False)
+    rend = Renderer(scene, **(renderer_kwargs or {}))
+    bar = nice_scale_bar(ulim[1] - ulim[0])
+    for j, i in enumerate(idx):
+        for r, cam in enumerate(CAMERAS):
+            ax = axes[r, j]
+            rend.draw(ax, X[i], cam)
+            sense = "CW" if om[i] < 0 else ("CCW" if om[i] > 0 else "stop")
+            style_view(ax, ulim, zlim,
+                       title=f"$t/T$ = {turns[i]:.2f} ({sense})" if r == 0 else None,
+                       scale_bar=bar if (j == 0 and r == 0) else None)
+        axes[0, j].set_title(axes[0, j].get_title(), fontsize=7)
+    for r, cam in enumerate(CAMERAS):
+        axes[r, 0].set_ylabel(cam.name, fontsize=7)
+        axes[r, 0].yaxis.label.set_visible(True)
+    if title is None:
+        hi = "with HI" if ds.attrs.get("hydrodynamics", 1) else "without HI"
+        title = f"{ds.attrs.get('title', 'flagwrap run')}: M = {float(ds.attrs['machin']):.4g}, {hi}"
+    fig.suptitle(title, fontsize=8)
+    fig.tight_layout(rect=(0, 0, 1, 0.96), w_pad=0.2, h_pad=0.3)
+    return fig
+
+
+def write_snapshots(ds, path, formats=("png", "pdf"), dpi: int = 200, **kwargs) -> list[Path]:
+    """Render :func:`snapshot_figure` and save it once per format (suffix replaced).
+
+    Returns the written paths.
+    """
+    import matplotlib.pyplot as plt
+
+    fig = snapshot_figure(ds, **kwargs)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    out = []
+    try:
+        for fmt in formats:
+            p = path.with_suffix("." + fmt.lstrip("."))
+            fig.savefig(p, dpi=dpi)
+            out.append(p)
+    finally:
+        plt.close(fig)
+    return out

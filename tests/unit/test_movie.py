@@ -1,0 +1,98 @@
+"""Movies: deterministic frame count (formula), size, MP4 and GIF read back with imageio."""
+
+import numpy as np
+import pytest
+
+from flagwrap.io.config import config_from_dict, tomllib
+from flagwrap.io.runfile import read_run, write_run
+from flagwrap.simulation import simulate
+
+TINY = """
+name = "tiny"
+[filament]
+length = 0.4
+helix_radius = 0.03
+turns = 2
+cross_section_radius = 0.0015
+youngs_modulus = 1.5e6
+n_beads = 21
+[motor]
+machin = 100
+protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.2}]
+[numerics]
+save_every = 0.05
+tol = 1e-3
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    path = tmp_path_factory.mktemp("movie") / "tiny.nc"
+    write_run(simulate(config_from_dict(tomllib.loads(TINY))), path)
+    return path
+
+
+def test_movie_frame_count_formula():
+    from flagwrap.plotting.movies import movie_times
+
+    t = np.linspace(0.0, 10.0, 21)  # saved every 0.5 s
+    # n = floor((t_end - t0) fps / speed) + 1
+    assert len(movie_times(t, fps=25, speed=2.0)) == 126
+    assert len(movie_times(t, fps=10, speed=3.0)) == 34  # floor(33.33) + 1
+    assert len(movie_times(t, fps=10, speed=None)) == 21  # auto: one frame per save
+    tm = movie_times(t, fps=10, speed=3.0)
+    np.testing.assert_allclose(np.diff(tm), 0.3)
+    assert tm[-1] <= t[-1]
+
+
+def test_speed_and_size_parsing():
+    from flagwrap.errors import UserInputError
+    from flagwrap.plotting.movies import parse_size, parse_speed
+
+    assert parse_speed("100x") == 100 and parse_speed("2.5") == 2.5 and parse_speed("auto") is None
+    assert parse_size("1000x570") == (992, 576)
+    for bad in ("fast", "-3x", "0x"):
+        with pytest.raises(UserInputError):
+            parse_speed(bad)
+
+
+def test_mp4_has_expected_frame_count_and_size(tiny_run, tmp_path):
+    import imageio.v2 as iio
+
+    from flagwrap.cli.main import main
+    from flagwrap.plotting.movies import movie_times
+
+    ds = read_run(tiny_run)
+    T = float(ds.attrs["period"])
+    speed = 0.1 * T  # 0.1 turn per movie second
+    fps = 20
+    n = len(movie_times(ds["time"].values, fps, speed))
+    assert n == int(np.floor(0.4 / 0.1 * fps + 1e-9)) + 1  # 0.4 turns long
+    out = tmp_path / "tiny.mp4"
+    rc = main(["movie", str(tiny_run), "-o", str(out), "--fps", str(fps), "--speed",
+               f"{speed!r}x", "--size", "320x192", "--quiet"])
+    assert rc == 0 and out.exists()
+    r = iio.get_reader(out)
+    assert r.count_frames() == n
+    assert r.get_meta_data()["size"] == (320, 192)
+    frame = r.get_data(n // 2)
+    assert frame.shape == (192, 320, 3) and frame.std() > 1
+    r.close()
+
+
+def test_gif_fallback(tiny_run, tmp_path):
+    import imageio.v2 as iio
+
+    from flagwrap.plotting.movies import write_movie
+
+    ds = read_run(tiny_run)
+    p = write_movie(ds, tmp_path / "tiny.gif", fps=10, size=(160, 96))
+    assert p.suffix == ".gif"
+    frames = list(iio.get_reader(p))
+    assert len(frames) == ds.sizes["time"] and frames[0].shape[:2] == (96, 160)
+
+
+def test_movie_of_missing_file_is_a_user_error(tmp_path):
+    from flagwrap.cli.main import main
+
+    assert main(["movie", str(tmp_path / "none.nc"), "--quiet"]) == 2
