@@ -21,6 +21,7 @@ COMMANDS: dict[str, str] = {
     "viscosity": "viscosity",
     "density": "density",
     "bacteria": "bacteria",
+    "analyze": "analyze",
     "snapshots": "snapshots",
     "movie": "movie",
     "export-vtk": "export_vtk",

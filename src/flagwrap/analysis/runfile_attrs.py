@@ -1,0 +1,126 @@
+"""Analyse a run file and store the results in it (``flagwrap analyze``).
+
+Scalars go to global attributes prefixed ``analysis_`` (netCDF attributes cannot be None or
+bool: undefined values are NaN, flags are 0/1); the criteria used go to
+``analysis_params`` (JSON). Per-frame series go to small variables:
+
+==========================  ======  =====================================================
+variable                    dims    meaning
+==========================  ======  =====================================================
+free_end_height             time    ``(z(L) - z(0)) / L``
+free_end_height_smoothed    time    running mean used by the onset detector
+winding_turns               time    ``|W| / 2 pi`` of the beads beside the body [turns]
+contact_fraction            time    fraction of beads beside the body
+perversion_bead             time    bead of the perversion nearest the clamp, -1 if none
+==========================  ======  =====================================================
+
+Re-running replaces earlier results. The file is rewritten atomically: written to a
+temporary file in the same folder, flushed, fsynced, then renamed over the original, so an
+interrupted analysis never damages the run.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from flagwrap.analysis.buckling import BucklingAnalysis
+from flagwrap.errors import UserInputError
+
+PREFIX = "analysis_"
+VARIABLES = ("free_end_height", "free_end_height_smoothed", "winding_turns", "contact_fraction",
+             "perversion_bead")
+
+
+def analyze_dataset(ds, analysis: BucklingAnalysis | None = None) -> BucklingAnalysis:
+    """Run :class:`BucklingAnalysis` on a run dataset (:func:`flagwrap.io.runfile.read_run`)."""
+    from flagwrap.io.runfile import config_of
+
+    need = ("position", "turns", "omega")
+    missing = [v for v in need if v not in ds.variables]
+    if missing or "length" not in ds.attrs:
+        raise UserInputError(f"run dataset lacks {missing or ['length attribute']}")
+    cfg = config_of(ds)
+    R = cfg.filament.helix_radius
+    if not cfg.body.enabled:
+        raise UserInputError("run has no cell body (body.enabled = false): nothing to wrap around")
+    if ds.sizes.get("time", 0) < 2:
+        raise UserInputError("run file has fewer than 2 saved frames")
+    a = analysis if analysis is not None else BucklingAnalysis()
+    tq = ds["motor_torque_reduced"].values if "motor_torque_reduced" in ds.variables else None
+    return a.compute(ds["turns"].values, ds["position"].values, ds["omega"].values,
+                     float(ds.attrs["length"]), cfg.body.resolved_radius(R),
+                     cfg.body.resolved_length(R), tq)
+
+
+def annotate(ds, analysis: BucklingAnalysis):
+    """Return a copy of ``ds`` with the results of a computed ``analysis`` stored in it."""
+    out = ds.drop_vars([v for v in VARIABLES if v in ds.variables])
+    out.attrs = {k: v for k, v in ds.attrs.items() if not k.startswith(PREFIX)}
+    for k, v in analysis.summary().items():
+        if isinstance(v, bool):
+            v = int(v)
+        out.attrs[PREFIX + k] = v
+    out.attrs[PREFIX + "params"] = json.dumps(analysis.params(), sort_keys=True)
+    from flagwrap import __version__
+
+    out.attrs[PREFIX + "version"] = __version__
+    w, f = analysis.waiting, analysis.final
+    out["free_end_height"] = ("time", analysis.height, {"units": "1", "long_name": "(z(L)-z(0))/L"})
+    out["free_end_height_smoothed"] = ("time", w.smoothed, {"units": "1"})
+    out["winding_turns"] = ("time", f.winding_series,
+                            {"units": "1", "long_name": "|winding| of beads beside the body [turns]"})
+    out["contact_fraction"] = ("time", f.contact_series, {"units": "1"})
+    out["perversion_bead"] = ("time", analysis.perversion_bead.astype(np.int32),
+                              {"units": "1", "long_name": "perversion bead nearest the clamp (-1 none)"})
+    return out
+
+
+def _write_atomic(ds, path: Path) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool = True) -> dict:
+    """Analyse the run file ``path``; store the results in it unless ``write`` is false.
+
+    Returns
+    -------
+    dict
+        :meth:`BucklingAnalysis.summary` plus ``params`` (the criteria) and ``path``.
+
+    Raises
+    ------
+    UserInputError
+        unreadable file, no CW phase, no cell body, too few frames.
+    """
+    from flagwrap.io.runfile import read_run
+
+    path = Path(path)
+    ds = read_run(path)
+    a = analyze_dataset(ds, analysis)
+    if write:
+        _write_atomic(annotate(ds, a), path)
+    res = a.summary()
+    res["params"] = a.params()
+    res["path"] = str(path)
+    res["run_status"] = str(ds.attrs.get("status", ""))
+    return res
+
+
+def jsonable(res: dict) -> dict:
+    """NaN -> None so that the result is valid JSON."""
+    return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in res.items()}

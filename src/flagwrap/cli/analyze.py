@@ -1,0 +1,72 @@
+"""Detect buckling, waiting time t_c and final state of run files; store them as attributes.
+
+Prints a summary per run file and writes the results into it (attributes ``analysis_*``,
+variables ``free_end_height``, ``winding_turns``, ``contact_fraction``, ``perversion_bead``;
+atomic rewrite) unless ``--no-write``. Criteria and defaults: docs/analysis.md.
+
+Examples::
+
+    flagwrap analyze out/k600.nc
+    flagwrap analyze out/*.nc --json --no-write
+"""
+
+from __future__ import annotations
+
+
+def add_arguments(p):
+    p.add_argument("runs", nargs="+", metavar="RUN.nc", help="run file(s) written by `flagwrap run`")
+    p.add_argument("--json", action="store_true", help="print one JSON object per run instead of a table")
+    p.add_argument("--no-write", action="store_true", help="do not store the results in the run file")
+    g = p.add_argument_group("criteria (defaults: docs/analysis.md)")
+    g.add_argument("--threshold", type=float, default=0.15, help="buckling rise of the free end [L] (0.15)")
+    g.add_argument("--hold-turns", type=float, default=1.0, help="rise must persist [turns] (1)")
+    g.add_argument("--smooth-turns", type=float, default=1.0, help="running-mean window [turns] (1)")
+    g.add_argument("--onset", choices=["hinge", "crossing"], default="hinge", help="t_c rule (hinge)")
+    g.add_argument("--min-winding", type=float, default=0.5, help="wrapping: winding [turns] (0.5)")
+    g.add_argument("--min-contact-fraction", type=float, default=0.3, help="wrapping: beads beside body (0.3)")
+    g.add_argument("--contact-distance", type=float, default=0.5, help="beside body: distance [R_cell] (0.5)")
+    g.add_argument("--final-turns", type=float, default=1.0, help="final-state window [turns] (1)")
+
+
+ROWS = [
+    ("state", "final state", "{}"),
+    ("buckled", "buckled", "{}"),
+    ("switch_turns", "CCW->CW switch t_s/T", "{:.3f}"),
+    ("waiting_time_turns", "waiting time t_c/T", "{:.3f}"),
+    ("crossing_turns", "threshold crossing (t-t_s)/T", "{:.3f}"),
+    ("perversion_turns", "first perversion (t-t_s)/T", "{:.3f}"),
+    ("baseline_height", "baseline (z(L)-z(0))/L", "{:+.4f}"),
+    ("max_height", "max height after switch", "{:+.4f}"),
+    ("final_height", "final height", "{:+.4f}"),
+    ("winding_turns", "final winding [turns]", "{:.3f}"),
+    ("contact_fraction", "final beside-body fraction", "{:.3f}"),
+    ("torque_peak_reduced", "CW torque peak N_m R/A", "{:+.3f}"),
+    ("torque_peak_turns", "  at (t-t_s)/T", "{:.3f}"),
+    ("torque_final_reduced", "final torque N_m R/A", "{:+.3f}"),
+]
+
+
+def run(args) -> int:
+    import json
+
+    from flagwrap.analysis.buckling import BucklingAnalysis, FinalState, WaitingTime
+    from flagwrap.analysis.runfile_attrs import analyze_run_file, jsonable
+
+    for path in args.runs:
+        analysis = BucklingAnalysis(
+            WaitingTime(threshold=args.threshold, hold_turns=args.hold_turns,
+                        smooth_turns=args.smooth_turns, onset=args.onset),
+            FinalState(min_winding_turns=args.min_winding,
+                       min_contact_fraction=args.min_contact_fraction,
+                       contact_distance=args.contact_distance, final_turns=args.final_turns),
+        )
+        res = analyze_run_file(path, analysis, write=not args.no_write)
+        if args.json:
+            print(json.dumps(jsonable(res), sort_keys=True))
+            continue
+        print(f"{path} (run status: {res['run_status']})"
+              + ("" if args.no_write else "  [results stored in file]"))
+        for key, label, fmt in ROWS:
+            v = res[key]
+            print(f"  {label:<30s} {fmt.format(v) if not (isinstance(v, float) and v != v) else '-'}")
+    return 0

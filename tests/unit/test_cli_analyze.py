@@ -1,0 +1,113 @@
+"""``flagwrap analyze`` end to end: a tiny real run, a synthetic wrapped run file, bad input."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from flagwrap.analysis import STATES
+from flagwrap.cli.main import main
+from flagwrap.io.runfile import config_of, read_run
+
+TINY = """
+name = "tiny"
+[filament]
+length = 0.4
+helix_radius = 0.03
+turns = 2
+cross_section_radius = 0.0015
+youngs_modulus = 1.5e6
+n_beads = 21
+[motor]
+machin = 100
+protocol = [{direction = "ccw", turns = 0.3}, {direction = "cw", turns = 0.3}]
+[numerics]
+save_every = 0.05
+tol = 1e-3
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    d = tmp_path_factory.mktemp("analyze")
+    cfgp = d / "tiny.toml"
+    cfgp.write_text(TINY)
+    out = d / "tiny.nc"
+    assert main(["run", str(cfgp), "-o", str(out), "--quiet"]) == 0
+    return out
+
+
+def test_analyze_writes_attributes_and_is_idempotent(tiny_run, capsys):
+    before = read_run(tiny_run)
+    assert main(["analyze", str(tiny_run)]) == 0
+    text = capsys.readouterr().out
+    assert "final state" in text and "stable" in text
+    ds = read_run(tiny_run)
+    assert ds.attrs["analysis_state"] == "stable" and ds.attrs["analysis_buckled"] == 0
+    assert ds.attrs["analysis_switch_turns"] == pytest.approx(0.3)
+    assert json.loads(ds.attrs["analysis_params"])["threshold"] == 0.15
+    np.testing.assert_allclose(ds["free_end_height"].values,
+                               (ds.position.values[:, -1, 2] - ds.position.values[:, 0, 2]) / 0.4)
+    # run data untouched
+    np.testing.assert_array_equal(ds.position.values, before.position.values)
+    assert ds.attrs["config_toml"] == before.attrs["config_toml"]
+    # rerun with other criteria replaces the results, leaves no temp files
+    assert main(["analyze", str(tiny_run), "--threshold", "0.2", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out.strip())
+    assert res["state"] in STATES and res["waiting_time_turns"] is None
+    assert json.loads(read_run(tiny_run).attrs["analysis_params"])["threshold"] == 0.2
+    assert sorted(p.name for p in tiny_run.parent.iterdir()) == ["tiny.nc", "tiny.toml"]
+
+
+def test_synthetic_wrapped_run_file(tiny_run, tmp_path, capsys):
+    """Replace the tiny run's trajectory by one that rises at t/T = 0.4 and winds once."""
+    ds = read_run(tiny_run)
+    cfg = config_of(ds)
+    R = cfg.filament.helix_radius
+    Rc = cfg.body.resolved_radius(R)
+    x = ds.position.values.copy()
+    n = x.shape[1]
+    th = np.linspace(0, 2 * np.pi, n - 2)
+    coil = np.stack([1.1 * Rc * np.cos(th), 1.1 * Rc * np.sin(th), 0.05 + 0.01 * th], axis=1)
+    wrapped = np.vstack([[0, 0, 0], [0.5 * Rc, 0, 0], coil])
+    t = ds.turns.values
+    x[t >= 0.4 - 1e-9] = wrapped
+    ds["position"] = (("time", "bead", "xyz"), x, ds["position"].attrs)
+    p = tmp_path / "wrapped.nc"
+    ds.to_netcdf(p, engine="h5netcdf")
+    assert main(["analyze", str(p), "--json", "--hold-turns", "0.1", "--smooth-turns", "0.05",
+                 "--final-turns", "0.1"]) == 0
+    res = json.loads(capsys.readouterr().out.strip())
+    assert res["state"] == "wrapping"
+    assert res["waiting_time_turns"] == pytest.approx(0.1, abs=0.051)
+    assert res["winding_turns"] == pytest.approx(1.0, abs=0.05)
+    assert read_run(p).attrs["analysis_state"] == "wrapping"
+
+
+def test_no_write_leaves_file_alone(tiny_run, tmp_path):
+    p = tmp_path / "copy.nc"
+    p.write_bytes(tiny_run.read_bytes())
+    data = p.read_bytes()
+    assert main(["analyze", str(p), "--no-write"]) == 0
+    assert p.read_bytes() == data
+
+
+def test_bad_input_exit_2(tmp_path):
+    bad = tmp_path / "bad.nc"
+    bad.write_bytes(b"not a run file")
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "analyze", str(bad)],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "error:" in r.stderr
+    assert main(["analyze", str(tmp_path / "missing.nc")]) == 2
+    assert main(["analyze", str(bad), "--threshold", "-1"]) == 2
+
+
+def test_ccw_only_run_is_reported(tiny_run, tmp_path, capsys):
+    ds = read_run(tiny_run)
+    ds["omega"] = ("time", np.abs(ds.omega.values), ds["omega"].attrs)
+    p = tmp_path / "ccw.nc"
+    ds.to_netcdf(p, engine="h5netcdf")
+    assert main(["analyze", str(p)]) == 2
+    assert "never turns CW" in capsys.readouterr().err
