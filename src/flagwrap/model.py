@@ -26,9 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flagwrap import _system_kernels as SK
 from flagwrap import units
 from flagwrap.body.cell_body import CappedCylinder, NoBody
-from flagwrap.elasticity import _kernels as EK
 from flagwrap.elasticity.rod import Frames, RestState, initial_frames, rest_state
 from flagwrap.geometry.helix import filament_positions
 from flagwrap.hydrodynamics.mobility import make_mobility
@@ -135,24 +135,30 @@ class RodSystem:
         return x, theta, phi
 
     # forces --------------------------------------------------------------------------------
+    def _kernel_args(self, base: Frames):
+        r, c, b = self.rest, self.clamp, self.body
+        has_body = not isinstance(b, NoBody)
+        return (self.nc, self.ec, c.x_ref, c.axis, c.theta_ref, c.twist_rate,
+                base.t, base.d1, base.rt, r.l0, r.vor, r.kbar, r.mbar, r.bending, r.twist,
+                r.stretch, has_body, b.radius if has_body else 0.0,
+                b.length if has_body else 0.0, b.sigma if has_body else 0.0,
+                b.strength if has_body else 0.0, self.gravity)
+
     def forces(self, y: np.ndarray, base: Frames) -> ForceInfo:
-        x, theta, phi = self.unpack(y)
-        r = self.rest
-        gx = np.empty_like(x)
-        gth = np.empty(self.N - 1)
+        """Generalized forces ``G = -dU/dy`` and everything computed with them."""
+        N = self.N
+        G = np.empty(self.ny)
+        x = np.empty((N, 3))
+        theta = np.empty(N - 1)
+        gx = np.empty((N, 3))
+        gth = np.empty(N - 1)
         d1 = np.empty_like(base.d1)
         rt = np.empty_like(base.rt)
-        E = EK.energy_grad(x, theta, base.t, base.d1, base.rt, r.l0, r.vor, r.kbar, r.mbar,
-                           r.bending, r.twist, r.stretch, gx, gth, d1, rt)
-        dist = np.empty(self.N)
-        Ec = self.body.energy_grad(x, gx, dist)
-        gx -= self.gravity
-        G = np.empty(self.ny)
-        G[self.sl_x] = -gx[self.nc:].ravel()
-        G[self.sl_th] = -gth[self.ec:]
-        G[-1] = 0.0
+        dist = np.empty(N)
+        E, Ec = SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base),
+                                      G, x, theta, gx, gth, d1, rt, dist)
         e = np.diff(x, axis=0)
-        t = e / np.linalg.norm(e, axis=1)[:, None]
+        t = e / np.sqrt(np.einsum("ij,ij->i", e, e))[:, None]
         return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist)
 
     def apply_mobility(self, y: np.ndarray, G: np.ndarray) -> np.ndarray:
@@ -229,6 +235,13 @@ class RodSystem:
             if cols:
                 groups.append((np.array(cols), np.array(rows_l), np.array(cols_l)))
         self._colors = groups
+        g_ptr = np.cumsum([0] + [len(g[0]) for g in groups]).astype(np.int64)
+        e_ptr = np.cumsum([0] + [len(g[1]) for g in groups]).astype(np.int64)
+        self._colors_flat = (
+            g_ptr, np.concatenate([g[0] for g in groups]).astype(np.int64),
+            e_ptr, np.concatenate([g[1] for g in groups]).astype(np.int64),
+            np.concatenate([g[2] for g in groups]).astype(np.int64),
+        )
 
     def force_jacobian(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
                        delta: float = 1e-7) -> np.ndarray:
@@ -237,15 +250,10 @@ class RodSystem:
             self._build_colors()
         if G0 is None:
             G0 = self.forces(y, base).G
-        J = np.zeros((self.ny, self.ny))
-        for cols, rows, cc in self._colors:
-            yp = y.copy()
-            yp[cols] += delta
-            dG = (self.forces(yp, base).G - G0) / delta
-            J[rows, cc] = dG[rows]
-        yp = y.copy()
-        yp[-1] += delta
-        J[:, -1] = (self.forces(yp, base).G - G0) / delta
+        J = np.empty((self.ny, self.ny))
+        g_ptr, g_cols, e_ptr, e_rows, e_cols = self._colors_flat
+        SK.fd_jacobian(np.ascontiguousarray(y), G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols,
+                       self.N, *self._kernel_args(base), J)
         return J
 
     # observables ---------------------------------------------------------------------------

@@ -19,7 +19,7 @@ youngs_modulus = 1.5e6
 n_beads = 21
 [motor]
 machin = 100
-protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.2}]
+protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.5}]
 [numerics]
 save_every = 0.05
 tol = 1e-3
@@ -37,7 +37,7 @@ def test_run_writes_self_describing_file(tmp_path):
     assert ds.attrs["status"] == "completed"
     assert ds.attrs["flagwrap_version"]
     assert ds["position"].shape[1:] == (21, 3)
-    np.testing.assert_allclose(ds["turns"].values[-1], 0.4, rtol=1e-9)
+    np.testing.assert_allclose(ds["turns"].values[-1], 0.7, rtol=1e-9)
     # the stored config reproduces the run's parameters
     cfg = config_of(ds)
     assert cfg.filament.n_beads == 21 and cfg.machin == np.float64(ds.attrs["machin"])

@@ -129,22 +129,33 @@ def test_forces_covariant_under_rigid_rotation():
 
 
 def test_run_invariant_under_rotation_about_body_axis():
-    # the body is symmetric about z: turning the initial helix about z turns the whole run
-    cfg = make_config(machin=200, protocol=(("ccw", 0.05),),
-                      numerics=Numerics(save_every=0.01, tol=1e-6))
+    # the body is symmetric about z: turning the initial helix about z turns the whole run.
+    # Fixed steps (same step sequence in both runs), so agreement is to rounding.
+    from flagwrap.elasticity.rod import Frames
+    from flagwrap.integrators import ROS2
+
+    cfg = make_config(machin=200)
     s = RodSystem(cfg)
     Rm = rotation_matrix(np.array([0, 0, 1.0]), 0.7)
     sr = RodSystem(cfg, x0=s.x0 @ Rm.T)
-    from flagwrap.elasticity.rod import Frames
-
     sr.frames0 = Frames(s.frames0.t @ Rm.T, s.frames0.d1 @ Rm.T, s.frames0.rt.copy())
     sr.rest = s.rest
-    a = Simulation(cfg, system=s).run()
-    b = Simulation(cfg, system=sr).run()
-    assert a.ok and b.ok
-    # rounding differs, so an adaptive step may be accepted differently: allow a few tol
-    np.testing.assert_allclose(np.asarray(b.x)[-1], np.asarray(a.x)[-1] @ Rm.T, atol=1e-5)
-    np.testing.assert_allclose(b.motor_torque, a.motor_torque, rtol=1e-4, atol=1e-4)
+    integ = ROS2()
+
+    def advance(system, n=60, h=0.01):
+        y = system.initial_y()
+        info = system.forces(y, system.frames0)
+        for _ in range(n):
+            r = integ.step(system, y, info.frames, info, h, 1.0)
+            y, info = r.y, r.info
+        return info, system.motor_torque(info, y[-1], 1.0)
+
+    (a, ta), (b, tb) = advance(s), advance(sr)
+    # not to rounding: the finite-difference Jacobian in W perturbs Cartesian components, so its
+    # O(delta/b ~ 6e-6) relative error is not rotation covariant; W only affects the step at the
+    # level of the local truncation error (~1e-5 L at h = 0.01), hence the tolerances.
+    np.testing.assert_allclose(b.x, a.x @ Rm.T, atol=1e-5)
+    assert tb == pytest.approx(ta, rel=1e-4)
 
 
 def test_jacobian_matches_directional_derivative():

@@ -1,0 +1,148 @@
+"""Fused numba kernels of :class:`flagwrap.model.RodSystem` (one call per force evaluation).
+
+``generalized_forces`` unpacks the state vector (clamp + free beads/bonds), evaluates the
+elastic energy and gradient, the body repulsion and gravity, and packs ``G = -dU/dy``;
+``fd_jacobian`` builds ``dG/dy`` by coloured one-sided differences. They exist only to remove
+Python overhead from the hot loop; the physics lives in the kernels they call.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from flagwrap.body._kernels import wca_energy_grad
+from flagwrap.elasticity._kernels import energy_grad
+
+
+@nb.njit(cache=True)
+def unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta):
+    N = x.shape[0]
+    phi = y[y.shape[0] - 1]
+    c = math.cos(phi)
+    s = math.sin(phi)
+    for i in range(nc):  # Rodrigues rotation of the clamped beads about the motor axis
+        v0, v1, v2 = x_ref[i, 0], x_ref[i, 1], x_ref[i, 2]
+        kx = axis[1] * v2 - axis[2] * v1
+        ky = axis[2] * v0 - axis[0] * v2
+        kz = axis[0] * v1 - axis[1] * v0
+        kv = axis[0] * v0 + axis[1] * v1 + axis[2] * v2
+        x[i, 0] = c * v0 + s * kx + (1 - c) * kv * axis[0]
+        x[i, 1] = c * v1 + s * ky + (1 - c) * kv * axis[1]
+        x[i, 2] = c * v2 + s * kz + (1 - c) * kv * axis[2]
+    k = 0
+    for i in range(nc, N):
+        x[i, 0] = y[k]
+        x[i, 1] = y[k + 1]
+        x[i, 2] = y[k + 2]
+        k += 3
+    for j in range(ec):
+        theta[j] = theta_ref[j] + twist_rate * phi
+    for j in range(ec, N - 1):
+        theta[j] = y[k]
+        k += 1
+
+
+@nb.njit(cache=True)
+def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
+                       base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
+                       has_body, Rc, H, sigma, eps, gravity,
+                       G, x, theta, gx, gth, d1_out, rt_out, dist):
+    """Fill ``G`` (ny,) and the work arrays; return (elastic energy, contact energy)."""
+    N = x.shape[0]
+    unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta)
+    E = energy_grad(x, theta, base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
+                    gx, gth, d1_out, rt_out)
+    Ec = 0.0
+    if has_body:
+        Ec = wca_energy_grad(x, nc, Rc, H, sigma, eps, gx, dist)
+    else:
+        for i in range(N):
+            dist[i] = np.inf
+    k = 0
+    for i in range(nc, N):
+        for m in range(3):
+            G[k] = -(gx[i, m] - gravity[i, m])
+            k += 1
+    for i in range(N):
+        for m in range(3):
+            gx[i, m] -= gravity[i, m]
+    for j in range(ec, N - 1):
+        G[k] = -gth[j]
+        k += 1
+    G[k] = 0.0
+    return E, Ec
+
+
+@nb.njit(cache=True)
+def fd_jacobian(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
+                nc, ec, x_ref, axis, theta_ref, twist_rate,
+                base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
+                has_body, Rc, H, sigma, eps, gravity, J):
+    """Dense ``J = dG/dy``: analytic stretching Hessian + coloured differences of the rest.
+
+    The stretching springs are ~1000x stiffer than bending; a finite-difference error of
+    relative size ``delta/b`` in their block would be an O(1) error in ``W = I - gamma h Mob J``
+    and spoil the W-method's error constant. So the springs' exact Hessian
+    ``k_s [t t + (1 - l0/l)(I - t t)]`` is assembled directly and only bending, twist and
+    contact (``ks = 0``) are differenced. Group ``g`` perturbs columns
+    ``g_cols[g_ptr[g]:g_ptr[g+1]]`` together and scatters into the (row, col) pairs
+    ``e_rows/e_cols[e_ptr[g]:e_ptr[g+1]]``; the motor-angle column is differenced apart.
+    """
+    ny = y.shape[0]
+    x = np.empty((N, 3))
+    theta = np.empty(N - 1)
+    gx = np.empty((N, 3))
+    gth = np.empty(N - 1)
+    d1 = np.empty((N - 1, 3))
+    rt = np.empty(N)
+    dist = np.empty(N)
+    G = np.empty(ny)
+    Gs = np.empty(ny)
+    yp = y.copy()
+    J[:, :] = 0.0
+    generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
+                       base_rt, l0, vor, kbar, mbar, A, C, 0.0, has_body, Rc, H, sigma,
+                       eps, gravity, Gs, x, theta, gx, gth, d1, rt, dist)
+    n_groups = g_ptr.shape[0] - 1
+    for g in range(n_groups):
+        for q in range(g_ptr[g], g_ptr[g + 1]):
+            yp[g_cols[q]] += delta
+        generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
+                           base_rt, l0, vor, kbar, mbar, A, C, 0.0, has_body, Rc, H, sigma,
+                           eps, gravity, G, x, theta, gx, gth, d1, rt, dist)
+        for q in range(e_ptr[g], e_ptr[g + 1]):
+            r = e_rows[q]
+            J[r, e_cols[q]] = (G[r] - Gs[r]) / delta
+        for q in range(g_ptr[g], g_ptr[g + 1]):
+            yp[g_cols[q]] = y[g_cols[q]]
+    # exact stretching Hessian on the free beads (J = -Hessian)
+    unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta)
+    for j in range(N - 1):
+        e0 = x[j + 1, 0] - x[j, 0]
+        e1 = x[j + 1, 1] - x[j, 1]
+        e2 = x[j + 1, 2] - x[j, 2]
+        ln = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        t = (e0 / ln, e1 / ln, e2 / ln)
+        c = 1.0 - l0[j] / ln
+        for a_ in range(3):
+            for b_ in range(3):
+                K = ks * (t[a_] * t[b_] + c * ((1.0 if a_ == b_ else 0.0) - t[a_] * t[b_]))
+                for p_ in range(2):
+                    ip = j + p_
+                    if ip < nc:
+                        continue
+                    for q_ in range(2):
+                        iq = j + q_
+                        if iq < nc:
+                            continue
+                        sgn = 1.0 if p_ == q_ else -1.0
+                        J[3 * (ip - nc) + a_, 3 * (iq - nc) + b_] -= sgn * K
+    yp[ny - 1] += delta
+    generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
+                       base_rt, l0, vor, kbar, mbar, A, C, ks, has_body, Rc, H, sigma,
+                       eps, gravity, G, x, theta, gx, gth, d1, rt, dist)
+    for r in range(ny):
+        J[r, ny - 1] = (G[r] - G0[r]) / delta
