@@ -25,6 +25,7 @@ COMMANDS: dict[str, str] = {
     "snapshots": "snapshots",
     "movie": "movie",
     "export-vtk": "export_vtk",
+    "figure": "figure",
 }
 
 
