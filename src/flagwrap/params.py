@@ -343,17 +343,19 @@ class Numerics:
 
     Attributes
     ----------
-    integrator : {"rosenbrock", "euler"}
-        "rosenbrock": adaptive, L-stable, linearly implicit 2nd-order ROS2 (default);
+    integrator : {"ros34pw2", "ros2", "euler"}
+        "ros34pw2" (default): adaptive, L-stable, 3rd-order Rosenbrock W-method (Rang &
+        Angermann 2005); "ros2": adaptive, L-stable, 2nd-order (Verwer et al. 1999);
         "euler": the paper-style explicit Euler reference (fixed ``dt``).
     hydrodynamics : bool
         long-range Rotne-Prager-Yamakawa interactions on (True) or self mobility only.
     dt : float
-        first (rosenbrock) or fixed (euler) step, in motor turns ``T``.
+        first (adaptive schemes) or fixed (euler) step, in motor turns ``T``.
     tol : float
         local error tolerance per step (positions in units of L; twist angles allowed 10x).
-        The default 1e-4 keeps the global error of the free end below ~1e-2 L per turn; 1e-3 is
-        visibly wrong (it can trigger a spurious CCW instability, see docs/numerics.md).
+        With ros34pw2 the default 1e-5 keeps the free end within ~1e-3 L and the motor torque
+        within ~0.5 % of a converged solution over a turn; loose tolerances are visibly wrong
+        (ros2 at 1e-3 triggers a spurious CCW instability; see docs/numerics.md).
     threads : int
         BLAS threads for the dense linear algebra of one run (1 is fastest at N ~ 60 and lets
         sweeps run one case per core).
@@ -365,19 +367,20 @@ class Numerics:
         hard cap on the number of steps.
     """
 
-    integrator: str = "rosenbrock"
+    integrator: str = "ros34pw2"
     hydrodynamics: bool = True
     dt: float = 1e-3
-    tol: float = 1e-4
+    tol: float = 1e-5
     dt_min: float = 1e-12
     save_every: float = 0.05
     max_steps: int = 50_000_000
     threads: int = 1
 
     def __post_init__(self):
-        if self.integrator not in ("rosenbrock", "euler"):
+        if self.integrator not in ("ros34pw2", "ros2", "euler"):
             raise UserInputError(
-                f"numerics.integrator must be 'rosenbrock' or 'euler', got {self.integrator!r}"
+                "numerics.integrator must be 'ros34pw2', 'ros2' or 'euler', "
+                f"got {self.integrator!r}"
             )
         if not isinstance(self.hydrodynamics, bool):
             raise UserInputError(

@@ -62,6 +62,8 @@ class Simulation:
 
     def __init__(self, config, system: RodSystem | None = None, integrator=None,
                  max_strain: float = 0.05):
+        if system is not None and system.config != config:
+            raise ValueError("Simulation: system was built from a different config")
         self.config = config
         self.system = system or RodSystem(config)
         num = config.numerics

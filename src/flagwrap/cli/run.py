@@ -17,7 +17,7 @@ def add_arguments(p):
     p.add_argument("-o", "--output", help="run file to write (.nc); default out/<name>.nc")
     p.add_argument("--figure", help="also write a summary figure (PNG/PDF) of tip height and torque")
     p.add_argument("--no-hi", action="store_true", help="switch long-range hydrodynamics off")
-    p.add_argument("--integrator", choices=["rosenbrock", "euler"], help="override numerics.integrator")
+    p.add_argument("--integrator", choices=["ros34pw2", "ros2", "euler"], help="override numerics.integrator")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 

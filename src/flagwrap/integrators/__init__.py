@@ -2,15 +2,18 @@
 
 from flagwrap.integrators.base import Integrator, StepResult
 from flagwrap.integrators.euler import ExplicitEuler
+from flagwrap.integrators.ros34pw2 import ROS34PW2
 from flagwrap.integrators.rosenbrock import ROS2
 
-
-def make_integrator(name: str, tol: float = 1e-3) -> Integrator:
-    if name == "euler":
-        return ExplicitEuler()
-    if name == "rosenbrock":
-        return ROS2(tol=tol)
-    raise ValueError(f"unknown integrator {name!r}")
+REGISTRY = {"ros34pw2": ROS34PW2, "ros2": ROS2, "euler": ExplicitEuler}
 
 
-__all__ = ["Integrator", "StepResult", "ExplicitEuler", "ROS2", "make_integrator"]
+def make_integrator(name: str, tol: float = 1e-5) -> Integrator:
+    if name not in REGISTRY:
+        raise ValueError(f"unknown integrator {name!r}; known: {', '.join(REGISTRY)}")
+    cls = REGISTRY[name]
+    return cls() if name == "euler" else cls(tol=tol)
+
+
+__all__ = ["Integrator", "StepResult", "ExplicitEuler", "ROS2", "ROS34PW2", "make_integrator",
+           "REGISTRY"]
