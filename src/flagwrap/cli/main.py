@@ -26,6 +26,7 @@ COMMANDS: dict[str, str] = {
     "movie": "movie",
     "export-vtk": "export_vtk",
     "figure": "figure",
+    "critical": "critical",
 }
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["fig3"]
+__all__ = ["fig3", "fig4", "fig6", "figS7", "plot_fig4", "plot_fig6", "plot_figS7"]
 
 #: SI stretching-test helix (SI "Uniaxial stretching test of a helix"), lengths [m], E [Pa].
 FIG3_HELIX = dict(radius=15e-3, pitch=34e-3, length=305e-3, youngs_modulus=1.2 * 1.33e6, poisson_ratio=0.49)
@@ -99,4 +99,276 @@ def fig3(outdir: str | Path = "out/figures", *, n_beads: int = 201, n_steps: int
     axd.set_title("deviation from Eq. 1 (finite length: ends on the force line)", fontsize=10)
     paths = _save(fig, Path(outdir), "fig3")
     plt.close(fig)
+    return paths
+
+
+# --- issue 4: Fig. 4(c-e), Fig. 6, SI Fig. S7(a) ------------------------------------------------
+# Pure plotting of run datasets (flagwrap.io.runfile.read_run); the runs themselves come from
+# flagwrap.analysis.paper_runs (cached; `flagwrap figure fig4|fig6|figS7` runs what is missing).
+# omega/omega_c is relative to THIS model's measured omega_c (docs/critical.md), not the paper's.
+
+
+def _mpl():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_png_pdf(fig, stem):
+    """Write ``stem.png`` (150 dpi) and ``stem.pdf``; return both paths."""
+    from pathlib import Path
+
+    stem = Path(stem)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    out = []
+    for ext in ("png", "pdf"):
+        p = stem.with_suffix(f".{ext}")
+        fig.savefig(p, dpi=150)
+        out.append(p)
+    return out
+
+
+def _after_switch(ds):
+    """``t/T - t_s/T`` and the switch index of a CCW -> CW run."""
+    from flagwrap.analysis.buckling import find_switch
+
+    turns = ds["turns"].values
+    i = find_switch(turns, ds["omega"].values)
+    t_s = turns[i - 1] if i > 0 else turns[0]
+    return turns - t_s, i
+
+
+def _height(ds):
+    x = ds["position"].values
+    return (x[:, -1, 2] - x[:, 0, 2]) / float(ds.attrs["length"])
+
+
+def plot_fig4(runs, path=None):
+    """Paper Fig. 4(c)-(e) for the Fig. 4(a) helix at two speeds, with and without HI.
+
+    Parameters
+    ----------
+    runs : dict
+        ``{(omega_ratio, hydrodynamics): dataset}``; ``omega_ratio = omega / omega_c`` of this
+        model (e.g. 0.85 and 2.05), ``hydrodynamics`` a bool. Missing entries are skipped.
+    path : path-like, optional
+        stem: writes ``path.png`` and ``path.pdf``.
+
+    Panels: (c) reduced motor torque ``N_m R / A`` against ``t/T`` (CCW > 0; the CCW -> CW switch
+    at 10 T); (d) free-end height ``[z(L) - z(0)]/L`` at the largest ratio with and without HI;
+    (e) 3D trajectory of the free end relative to the clamp, ``[r(L) - r(0)]/L``, for the largest
+    ratio with HI, coloured by time after the switch.
+    """
+    plt = _mpl()
+    fig = plt.figure(figsize=(13, 4.2))
+    ac = fig.add_subplot(1, 3, 1)
+    ad = fig.add_subplot(1, 3, 2)
+    ae = fig.add_subplot(1, 3, 3, projection="3d")
+    ratios = sorted({r for r, _ in runs})
+    colors = {r: f"C{k}" for k, r in enumerate(ratios)}
+    for (ratio, hi), ds in sorted(runs.items(), key=lambda kv: (kv[0][0], not kv[0][1])):
+        ls = "-" if hi else "--"
+        lab = rf"$\omega/\omega_c$ = {ratio:g}, {'with' if hi else 'without'} HI"
+        ac.plot(ds["turns"].values, ds["motor_torque_reduced"].values, ls, color=colors[ratio], lw=1, label=lab)
+        if ratio == ratios[-1]:
+            ad.plot(ds["turns"].values, _height(ds), ls, color="k" if hi else "C3", lw=1,
+                    label=f"{'with' if hi else 'without'} HI")
+    t_sw = [float(ds["turns"].values[_after_switch(ds)[1] - 1]) for ds in runs.values()][:1]
+    for ax in (ac, ad):
+        ax.set_xlabel(r"$t/T$ [motor turns] (dotted: CCW$\to$CW switch)")
+        for t in t_sw:
+            ax.axvline(t, color="0.6", lw=0.8, ls=":")
+    ac.axhline(0, color="0.6", lw=0.6)
+    ac.set_ylabel(r"motor torque $N_m R/A$ (CCW > 0) [1]")
+    ac.set_title("(c) motor torque")
+    ac.legend(fontsize=7)
+    ad.set_ylabel(r"free-end height $[z(L)-z(0)]/L$ [1]")
+    ad.set_title(rf"(d) free end, $\omega/\omega_c$ = {ratios[-1]:g}" if ratios else "(d)")
+    ad.legend(fontsize=8)
+    key = (ratios[-1], True) if ratios and (ratios[-1], True) in runs else next(iter(runs), None)
+    if key is not None:
+        ds = runs[key]
+        x = ds["position"].values
+        tip = (x[:, -1] - x[:, 0]) / float(ds.attrs["length"])
+        ts, i = _after_switch(ds)
+        sel = slice(max(i - 1, 0), None)
+        ae.plot(tip[:max(i, 1), 0], tip[:max(i, 1), 1], tip[:max(i, 1), 2], color="0.7", lw=0.6, label="CCW")
+        sc = ae.scatter(tip[sel, 0], tip[sel, 1], tip[sel, 2], c=ts[sel], cmap="viridis", s=3)
+        fig.colorbar(sc, ax=ae, shrink=0.6, pad=0.1, label=r"$(t - t_s)/T$ after switch")
+        ae.set_title(rf"(e) free end, $\omega/\omega_c$ = {key[0]:g}, {'with' if key[1] else 'without'} HI", fontsize=9)
+    ae.set_xlabel(r"$x/L$")
+    ae.set_ylabel(r"$y/L$")
+    ae.set_zlabel(r"$z/L$")
+    fig.tight_layout()
+    if path is not None:
+        save_png_pdf(fig, path)
+    return fig
+
+
+def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_line=0.5):
+    """Paper Fig. 6: waiting time ``t_c/T`` against ``eps = (omega - omega_c)/omega_c``.
+
+    Parameters
+    ----------
+    eps, waiting_time : array_like, shape (K,)
+        runs that buckled (NaN entries are skipped).
+    fit : flagwrap.analysis.waiting_time.PowerLawFit, optional
+        drawn as a line with its ``c``, ``beta`` in the legend.
+    waiting_time_err : array_like, optional
+        error bars of ``t_c/T``.
+    c_line : float
+        the paper's line ``c_line / eps`` (0.5).
+
+    Main axes linear (as the paper), inset log-log.
+    """
+    plt = _mpl()
+    e = np.asarray(eps, float)
+    t = np.asarray(waiting_time, float)
+    ok = np.isfinite(e) & np.isfinite(t) & (e > 0)
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    grid = np.geomspace(max(min(e[ok].min(), 0.05) * 0.8, 1e-3), max(e[ok].max(), 2.0) * 1.1, 200) if ok.any() \
+        else np.geomspace(0.04, 2.2, 200)
+    ins = ax.inset_axes([0.52, 0.48, 0.44, 0.46])
+    for a in (ax, ins):
+        err = None if waiting_time_err is None else np.asarray(waiting_time_err, float)[ok]
+        a.errorbar(e[ok], t[ok], yerr=err, fmt="o", color="k", ms=4, label="flagwrap runs")
+        a.plot(grid, c_line / grid, "--", color="C0", label=rf"paper: ${c_line:g}/\epsilon$")
+        if fit is not None:
+            a.plot(grid, fit.predict(grid), "-", color="C3",
+                   label=rf"fit: $({fit.c:.2f}\pm{fit.c_err:.2f})\,\epsilon^{{-({fit.beta:.2f}\pm{fit.beta_err:.2f})}}$")
+    ins.set_xscale("log")
+    ins.set_yscale("log")
+    ins.tick_params(labelsize=7)
+    ax.axhline(1.0, color="0.7", lw=0.6, ls=":")
+    ax.axvline(1.0, color="0.7", lw=0.6, ls=":")
+    ax.set_xlabel(r"$\epsilon = (\omega-\omega_c)/\omega_c$ [1] ($\omega_c$ of this model)")
+    ax.set_ylabel(r"waiting time $t_c/T$ [motor turns]")
+    top = np.nanmax(t[ok]) if ok.any() else 10.0
+    ax.set_ylim(0, 1.15 * max(top, 1.0))
+    ax.set_xlim(0, grid.max())
+    ax.legend(loc="lower left", fontsize=7)
+    fig.tight_layout()
+    if path is not None:
+        save_png_pdf(fig, path)
+    return fig
+
+
+def plot_figS7(runs, path=None):
+    """SI Fig. S7(a): free-end height against time after the switch for several speeds, ``t_c`` marked.
+
+    Parameters
+    ----------
+    runs : list of (omega_ratio, dataset, t_c) tuples
+        ``t_c/T`` after the switch (NaN: not buckled, nothing marked).
+    """
+    plt = _mpl()
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    for k, (ratio, ds, tc) in enumerate(sorted(runs, key=lambda r: r[0])):
+        ts, i = _after_switch(ds)
+        h = _height(ds)
+        sel = ts >= -1.0
+        ax.plot(ts[sel], h[sel], color=f"C{k}", lw=1, label=rf"$\omega/\omega_c$ = {ratio:.3g}")
+        if np.isfinite(tc):
+            j = int(np.argmin(np.abs(ts - tc)))
+            ax.plot(ts[j], h[j], "v", color=f"C{k}", ms=8, mec="k")
+    ax.axvline(0, color="0.6", lw=0.8, ls=":")
+    ax.set_xlabel(r"$(t - t_s)/T$ after the CCW$\to$CW switch [motor turns]")
+    ax.set_ylabel(r"free-end height $[z(L)-z(0)]/L$ [1]")
+    ax.set_title(r"SI Fig. S7(a): $\psi$ = 70$^\circ$, n = 3 ($\blacktriangledown$ = $t_c$)", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    if path is not None:
+        save_png_pdf(fig, path)
+    return fig
+
+
+def _fig6_data(root=".", on_run=None):
+    """Critical search of the n = 3 helix, then the waiting-time sweep and its fit."""
+    from flagwrap.analysis import paper_runs
+    from flagwrap.analysis.waiting_time import PowerLawFit
+
+    mc = paper_runs.critical("movie7", root=root).machin_c
+    rows = paper_runs.fig6_runs(mc, on_run=on_run, root=root)
+    eps = np.array([r["eps"] for r in rows])
+    tc = np.array([r["waiting_time"] for r in rows])
+    fit = PowerLawFit().compute(eps, tc) if np.isfinite(tc).sum() >= 3 else None
+    return mc, rows, eps, tc, fit
+
+
+def fig4(outdir: str | Path = "out/figures", root=".") -> list[Path]:
+    """Fig. 4(c)-(e) from the cached runs of :func:`flagwrap.analysis.paper_runs.fig4_runs`
+    (the critical search of the Fig. 4(a) helix and the four runs are made if missing)."""
+    from flagwrap.analysis import paper_runs
+    from flagwrap.io.runfile import read_run
+
+    search = paper_runs.critical("fig4a", root=root)
+    mc = search.machin_c
+    files = paper_runs.fig4_runs(mc, root=root)
+    runs = {k: read_run(p) for k, p in files.items()}
+    fig = plot_fig4(runs)
+    paths = _save(fig, Path(outdir), "fig4")
+    _mpl().close(fig)
+    numbers = {"machin_c": mc, "bracket": list(search.bracket),
+               "runs": [{"omega_ratio": r, "file": str(files[(r, hi)]),
+                         **paper_runs.torque_summary(runs[(r, hi)])} for r, hi in sorted(runs)]}
+    paths.append(_write_json(numbers, Path(outdir) / "fig4.json"))
+    return paths
+
+
+def _write_json(obj, path: Path) -> Path:
+    import json
+    import math
+
+    def clean(v):
+        if isinstance(v, float) and math.isnan(v):
+            return None
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        if isinstance(v, np.generic):
+            return clean(v.item())
+        return v
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(clean(obj), indent=1, sort_keys=True))
+    return path
+
+
+def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
+    """Fig. 6 (waiting time against eps, 0.5/eps, fit, log-log inset) from cached sweep runs."""
+    from flagwrap.analysis.waiting_time import PowerLawFit
+
+    mc, rows, eps, tc, fit = _fig6_data(root)
+    fig = plot_fig6(eps, tc, fit)
+    paths = _save(fig, Path(outdir), "fig6")
+    _mpl().close(fig)
+    fits = {}
+    n_ok = int(np.isfinite(tc).sum())
+    if fit is not None:
+        fits["free_beta"] = fit.summary()
+    if n_ok >= 2:
+        fits["beta_1"] = PowerLawFit(fix_beta=1.0).compute(eps, tc).summary()
+    if n_ok >= 4:
+        m = np.array([r["machin"] for r in rows])
+        try:
+            fits["free_beta_free_Mc"] = PowerLawFit().compute(waiting_time=tc, machin=m, machin_c0=mc).summary()
+        except Exception as exc:  # report, do not fail the figure
+            fits["free_beta_free_Mc"] = {"error": str(exc)}
+    paths.append(_write_json({"machin_c": mc, "rows": rows, "fits": fits}, Path(outdir) / "fig6.json"))
+    return paths
+
+
+def figS7(outdir: str | Path = "out/figures", root=".") -> list[Path]:
+    """SI Fig. S7(a) (free-end height for several omega, t_c marked) from the Fig. 6 sweep runs."""
+    from flagwrap.io.runfile import read_run
+
+    _, rows, _, _, _ = _fig6_data(root)
+    runs = [(r["omega_ratio"], read_run(r["path"]), r["waiting_time"]) for r in rows]
+    fig = plot_figS7(runs)
+    paths = _save(fig, Path(outdir), "figS7")
+    _mpl().close(fig)
     return paths

@@ -1,0 +1,152 @@
+"""Critical search on a fake, instant simulator with a known threshold (oracle: M_true)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from flagwrap.analysis.critical import CriticalSearch, RunCache, config_key, probe_config
+from flagwrap.cases import get_case
+from flagwrap.errors import UserInputError
+
+M_TRUE = 417.0
+
+
+class FakeRunner:
+    """Buckled iff M > M_TRUE; t_c/T = 0.5/eps; counts calls."""
+
+    def __init__(self, m_true=M_TRUE):
+        self.m_true, self.calls = m_true, []
+
+    def __call__(self, cfg, path):
+        m = cfg.machin
+        self.calls.append(m)
+        eps = m / self.m_true - 1
+        b = eps > 0
+        return {"buckled": b, "waiting_time_turns": 0.5 / eps if b else float("nan"),
+                "state": "folding" if b else "stable", "run_status": "completed",
+                "torque_peak_reduced": -1.0}
+
+
+@pytest.fixture
+def cfg():
+    return get_case("fig4a")
+
+
+@pytest.mark.parametrize("guess", [100.0, 283.0, 3000.0])
+@pytest.mark.parametrize("rtol", [0.1, 0.02])
+def test_converges_to_rtol(tmp_path, cfg, guess, rtol):
+    fake = FakeRunner()
+    s = CriticalSearch(rtol=rtol, cache=RunCache(tmp_path, runner=fake)).compute(cfg, guess=guess)
+    lo, hi = s.bracket
+    assert s.converged and s.monotone
+    assert lo < M_TRUE <= hi
+    assert hi / lo - 1 <= rtol
+    assert abs(s.machin_c / M_TRUE - 1) <= rtol
+    # every run is reported, in order, with its verdict
+    assert [r.machin for r in s.runs] == pytest.approx(fake.calls)
+    assert all(r.buckled == (r.machin > M_TRUE) for r in s.runs)
+    # bisection halves log(hi/lo): the run count is bounded
+    assert len(s.runs) <= 2 + math.ceil(math.log2(abs(math.log(guess / M_TRUE)) / math.log(2)) + 1) \
+        + math.ceil(math.log2(math.log(2) / math.log(1 + rtol)))
+
+
+def test_omega_c_from_machin_c(tmp_path, cfg):
+    s = CriticalSearch(rtol=0.05, cache=RunCache(tmp_path, runner=FakeRunner())).compute(cfg)
+    fil = cfg.filament
+    assert s.omega_c == pytest.approx(s.machin_c * fil.bending_modulus / (cfg.fluid.viscosity * fil.length**4))
+    assert s.frequency_c == pytest.approx(s.omega_c / (2 * math.pi))
+
+
+def test_reuses_cached_runs(tmp_path, cfg):
+    fake = FakeRunner()
+    s1 = CriticalSearch(rtol=0.1, cache=RunCache(tmp_path, runner=fake)).compute(cfg)
+    n1 = len(fake.calls)
+    assert n1 == len(s1.runs) and not any(r.reused for r in s1.runs)
+    # same search again: nothing simulated, same result
+    cache = RunCache(tmp_path, runner=fake)
+    s2 = CriticalSearch(rtol=0.1, cache=cache).compute(cfg)
+    assert len(fake.calls) == n1 and cache.n_simulated == 0
+    assert all(r.reused for r in s2.runs) and s2.machin_c == s1.machin_c
+    # a finer tolerance continues from the cached runs
+    cache = RunCache(tmp_path, runner=fake)
+    s3 = CriticalSearch(rtol=0.01, cache=cache).compute(cfg)
+    assert cache.n_simulated == len(fake.calls) - n1 > 0
+    assert sum(r.reused for r in s3.runs) == n1
+    assert abs(s3.machin_c / M_TRUE - 1) <= 0.01
+
+
+def test_bracket_given_and_wrong_belief_widened(tmp_path, cfg):
+    s = CriticalSearch(rtol=0.05, cache=RunCache(tmp_path, runner=FakeRunner())).compute(
+        cfg, bracket=(283.0, 600.0))
+    assert s.runs[0].machin == 283.0 and s.runs[1].machin == 600.0
+    assert s.bracket[0] < M_TRUE <= s.bracket[1]
+    # both ends buckle: the search goes down by `factor`
+    s = CriticalSearch(rtol=0.05, cache=RunCache(tmp_path / "b", runner=FakeRunner(150.0))).compute(
+        cfg, bracket=(283.0, 600.0))
+    assert s.converged and s.bracket[0] < 150.0 <= s.bracket[1]
+
+
+def test_max_runs_not_converged(tmp_path, cfg):
+    s = CriticalSearch(rtol=1e-4, max_runs=4, cache=RunCache(tmp_path, runner=FakeRunner())).compute(cfg)
+    assert not s.converged and len(s.runs) == 4
+
+
+def test_key_depends_on_config_and_protocol(cfg):
+    a = probe_config(cfg, 300.0)
+    assert config_key(a) == config_key(probe_config(cfg, 300.0))
+    assert config_key(a) != config_key(probe_config(cfg, 300.1))
+    assert config_key(a) != config_key(probe_config(cfg, 300.0, cw_turns=12))
+    assert a.motor.protocol[0].direction == "ccw" and a.motor.protocol[0].turns == 5.0
+    assert a.machin == pytest.approx(300.0)
+
+
+def test_guards(tmp_path, cfg):
+    with pytest.raises(UserInputError):
+        CriticalSearch(rtol=0)
+    with pytest.raises(UserInputError):
+        CriticalSearch(factor=1.0)
+    s = CriticalSearch(cache=RunCache(tmp_path, runner=FakeRunner()))
+    with pytest.raises(AttributeError):
+        s.machin_c
+    with pytest.raises(UserInputError):
+        s.compute(cfg, bracket=(600.0, 283.0))
+
+
+def test_cli_with_fake_runner(tmp_path, cfg, monkeypatch, capsys):
+    import flagwrap.analysis.critical as crit
+    from flagwrap.cli.main import main
+    from flagwrap.io.config import config_to_toml
+
+    path = tmp_path / "c.toml"
+    path.write_text(config_to_toml(cfg))
+
+    class Cache(RunCache):
+        def __init__(self, directory, runner=None):
+            super().__init__(directory, runner=FakeRunner())
+
+    monkeypatch.setattr(crit, "RunCache", Cache)
+    rc = main(["critical", str(path), "--rtol", "0.1", "--cache", str(tmp_path / "cache")])
+    out = capsys.readouterr().out
+    assert rc == 0
+    assert "M_c" in out and "omega_c" in out
+    assert out.count("out/critical") == 0 and out.count(".nc") >= 3
+
+
+def test_chunked_run_equals_full_run(cfg):
+    """Oracle: the uninterrupted simulator. Restarting at chunk edges only resets the step size."""
+    import numpy as np
+
+    from flagwrap.analysis.critical import simulate_until_buckled
+    from flagwrap.io.config import config_from_dict
+    from flagwrap.simulation import simulate
+
+    d = cfg.to_dict()
+    d["filament"]["n_beads"] = 21
+    small = probe_config(config_from_dict(d), 283.0, ccw_turns=0.5, cw_turns=2.0)
+    a = simulate(small)
+    b = simulate_until_buckled(small, stop_after=2.0, chunk_turns=0.5)
+    assert a.ok and b.ok and len(a.t) == len(b.t)
+    np.testing.assert_allclose(b.t, a.t, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(b.x), np.asarray(a.x), atol=1e-4)
