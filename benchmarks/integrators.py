@@ -104,7 +104,7 @@ def main():
         wall_f = time.perf_counter() - t0
         assert fast.ok, fast.message
         per_turn_f = wall_f / (2 * turns)
-        print(f"ros2 (tol = {cfg.numerics.tol:g}): {2 * turns} turns, {fast.n_steps} steps "
+        print(f"{cfg.numerics.integrator} (tol = {cfg.numerics.tol:g}): {2 * turns} turns, {fast.n_steps} steps "
               f"({fast.n_rejected} rejected) in {wall_f:.1f} s -> {per_turn_f:.3g} s per motor turn")
         # -- 3. accuracy against a converged solution
         t0 = time.perf_counter()
@@ -121,7 +121,7 @@ def main():
         print(f"converged reference (tol = 1e-6): {ref.n_steps} steps in {wall_r:.1f} s")
         print(f"accuracy: max free-end deviation {tip_err:.2e} L (target 1e-2), "
               f"first-CW-turn torque deviation {tq_err:.2%} (target 2 %)")
-        print(f"wall per turn: euler {per_turn_e:.4g} s, ros2 {per_turn_f:.4g} s")
+        print(f"wall per turn: euler {per_turn_e:.4g} s, {cfg.numerics.integrator} {per_turn_f:.4g} s")
         print(f"ratio: {per_turn_e / per_turn_f:.0f}")
 
 

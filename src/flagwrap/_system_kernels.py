@@ -77,18 +77,18 @@ def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
 
 
 @nb.njit(cache=True)
-def fd_jacobian(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
-                nc, ec, x_ref, axis, theta_ref, twist_rate,
-                base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
-                has_body, Rc, H, sigma, eps, gravity, J):
-    """Dense ``J = dG/dy``: analytic stretching Hessian + coloured differences of the rest.
+def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
+                    nc, ec, x_ref, axis, theta_ref, twist_rate,
+                    base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
+                    has_body, Rc, H, sigma, eps, gravity):
+    """``J = dG/dy`` as COO triplets (duplicates to be summed), O(N) time and memory.
 
-    The stretching springs are ~1000x stiffer than bending; a finite-difference error of
-    relative size ``delta/b`` in their block would be an O(1) error in ``W = I - gamma h Mob J``
-    and spoil the W-method's error constant. So the springs' exact Hessian
-    ``k_s [t t + (1 - l0/l)(I - t t)]`` is assembled directly and only bending, twist and
-    contact (``ks = 0``) are differenced. Group ``g`` perturbs columns
-    ``g_cols[g_ptr[g]:g_ptr[g+1]]`` together and scatters into the (row, col) pairs
+    Analytic stretching Hessian + coloured differences of the rest. The stretching springs are
+    ~1000x stiffer than bending; a finite-difference error of relative size ``delta/b`` in
+    their block would be an O(1) error in ``W = I - gamma h Mob J`` and spoil the W-method's
+    error constant, so their exact Hessian ``k_s [t t + (1 - l0/l)(I - t t)]`` is assembled
+    directly and only bending, twist and contact (``ks = 0``) are differenced. Group ``g``
+    perturbs columns ``g_cols[g_ptr[g]:g_ptr[g+1]]`` together and fills the (row, col) pairs
     ``e_rows/e_cols[e_ptr[g]:e_ptr[g+1]]``; the motor-angle column is differenced apart.
     """
     ny = y.shape[0]
@@ -102,7 +102,11 @@ def fd_jacobian(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
     G = np.empty(ny)
     Gs = np.empty(ny)
     yp = y.copy()
-    J[:, :] = 0.0
+    n_e = e_rows.shape[0]
+    n_tot = n_e + 36 * (N - 1) + ny
+    rows = np.empty(n_tot, np.int64)
+    cols = np.empty(n_tot, np.int64)
+    vals = np.empty(n_tot)
     generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, vor, kbar, mbar, A, C, 0.0, has_body, Rc, H, sigma,
                        eps, gravity, Gs, x, theta, gx, gth, d1, rt, dist)
@@ -115,9 +119,12 @@ def fd_jacobian(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
                            eps, gravity, G, x, theta, gx, gth, d1, rt, dist)
         for q in range(e_ptr[g], e_ptr[g + 1]):
             r = e_rows[q]
-            J[r, e_cols[q]] = (G[r] - Gs[r]) / delta
+            rows[q] = r
+            cols[q] = e_cols[q]
+            vals[q] = (G[r] - Gs[r]) / delta
         for q in range(g_ptr[g], g_ptr[g + 1]):
             yp[g_cols[q]] = y[g_cols[q]]
+    k = n_e
     # exact stretching Hessian on the free beads (J = -Hessian)
     unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta)
     for j in range(N - 1):
@@ -139,10 +146,26 @@ def fd_jacobian(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
                         if iq < nc:
                             continue
                         sgn = 1.0 if p_ == q_ else -1.0
-                        J[3 * (ip - nc) + a_, 3 * (iq - nc) + b_] -= sgn * K
+                        rows[k] = 3 * (ip - nc) + a_
+                        cols[k] = 3 * (iq - nc) + b_
+                        vals[k] = -sgn * K
+                        k += 1
     yp[ny - 1] += delta
     generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, vor, kbar, mbar, A, C, ks, has_body, Rc, H, sigma,
                        eps, gravity, G, x, theta, gx, gth, d1, rt, dist)
     for r in range(ny):
-        J[r, ny - 1] = (G[r] - G0[r]) / delta
+        v = (G[r] - G0[r]) / delta
+        if v != 0.0:
+            rows[k] = r
+            cols[k] = ny - 1
+            vals[k] = v
+            k += 1
+    return rows[:k], cols[:k], vals[:k]
+
+
+@nb.njit(cache=True)
+def scatter_dense(rows, cols, vals, J):
+    J[:, :] = 0.0
+    for q in range(rows.shape[0]):
+        J[rows[q], cols[q]] += vals[q]

@@ -177,6 +177,28 @@ class RodSystem:
         f[-1] = omega
         return f, info
 
+    def local_mobility_diagonal(self) -> np.ndarray:
+        """Diagonal of the self (no-HI) mobility in core units, (ny,); 0 for the motor angle."""
+        d = np.zeros(self.ny)
+        d[self.sl_x] = 1.0 / (6.0 * math.pi * self.radius * self.machin)
+        d[self.sl_th] = 1.0 / (self.machin * self.rot_drag[self.ec:])
+        return d
+
+    def near_field_mobility(self, y: np.ndarray, width: int | None = None):
+        """Sparse ``Mob`` restricted to bead pairs within ``width`` along the chain (core units).
+
+        Default width covers the overlapping neighbours (``4a/b`` beads) plus 4: the part of
+        the hydrodynamics that acts on the stiff, short-wavelength modes.
+        """
+        import scipy.sparse as sp
+
+        if width is None:
+            width = int(math.ceil(4 * self.radius / self.bond)) + 4
+        x, _, _ = self.unpack(y)
+        Mx = self.mobility.near_field(x[self.nc:], width) / self.machin
+        d = self.local_mobility_diagonal()
+        return sp.block_diag((Mx, sp.diags(d[3 * self.nb:])), format="csr")
+
     def mobility_matrix(self, y: np.ndarray) -> np.ndarray:
         """Dense ``Mob(y)`` (ny, ny)."""
         x, _, _ = self.unpack(y)
@@ -243,18 +265,31 @@ class RodSystem:
             np.concatenate([g[2] for g in groups]).astype(np.int64),
         )
 
-    def force_jacobian(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
-                       delta: float = 1e-7) -> np.ndarray:
-        """``dG/dy`` (ny, ny), dense, by one-sided coloured differences (~21 force calls)."""
+    def force_jacobian_coo(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
+                           delta: float = 1e-7):
+        """``dG/dy`` as COO triplets (rows, cols, vals; duplicates add), O(N) work and memory."""
         if self._colors is None:
             self._build_colors()
         if G0 is None:
             G0 = self.forces(y, base).G
-        J = np.empty((self.ny, self.ny))
         g_ptr, g_cols, e_ptr, e_rows, e_cols = self._colors_flat
-        SK.fd_jacobian(np.ascontiguousarray(y), G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols,
-                       self.N, *self._kernel_args(base), J)
+        return SK.fd_jacobian_coo(np.ascontiguousarray(y), G0, delta, g_ptr, g_cols, e_ptr,
+                                  e_rows, e_cols, self.N, *self._kernel_args(base))
+
+    def force_jacobian(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
+                       delta: float = 1e-7) -> np.ndarray:
+        """``dG/dy`` (ny, ny), dense: analytic stretching + coloured differences (~21 force calls)."""
+        rows, cols, vals = self.force_jacobian_coo(y, base, G0, delta)
+        J = np.empty((self.ny, self.ny))
+        SK.scatter_dense(rows, cols, vals, J)
         return J
+
+    def force_jacobian_sparse(self, y, base, G0=None, delta: float = 1e-7):
+        """``dG/dy`` as a scipy CSR matrix (for the matrix-free large-N path)."""
+        import scipy.sparse as sp
+
+        rows, cols, vals = self.force_jacobian_coo(y, base, G0, delta)
+        return sp.csr_matrix((vals, (rows, cols)), shape=(self.ny, self.ny))
 
     # observables ---------------------------------------------------------------------------
     def motor_torque(self, info: ForceInfo, phi: float, omega: float) -> float:

@@ -89,3 +89,42 @@ def rpy_apply(x, a, F, out):
             out[j, 0] += f * F[i, 0] + g * di * d0
             out[j, 1] += f * F[i, 1] + g * di * d1
             out[j, 2] += f * F[i, 2] + g * di * d2
+
+
+@nb.njit(cache=True)
+def rpy_band_coo(x, a, w):
+    """RPY blocks for |i - j| <= w as COO triplets (near-field part, for preconditioners)."""
+    n = x.shape[0]
+    nnz = 0
+    for i in range(n):
+        lo = max(0, i - w)
+        hi = min(n - 1, i + w)
+        nnz += 9 * (hi - lo + 1)
+    rows = np.empty(nnz, np.int64)
+    cols = np.empty(nnz, np.int64)
+    vals = np.empty(nnz)
+    k = 0
+    s = 1.0 / (6.0 * math.pi * a)
+    for i in range(n):
+        for j in range(max(0, i - w), min(n - 1, i + w) + 1):
+            if i == j:
+                for p in range(3):
+                    for q in range(3):
+                        rows[k] = 3 * i + p
+                        cols[k] = 3 * j + q
+                        vals[k] = s if p == q else 0.0
+                        k += 1
+                continue
+            d0 = x[i, 0] - x[j, 0]
+            d1 = x[i, 1] - x[j, 1]
+            d2 = x[i, 2] - x[j, 2]
+            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            f, g = _pair(r, a)
+            u = (d0 / r, d1 / r, d2 / r) if r > 0.0 else (0.0, 0.0, 0.0)
+            for p in range(3):
+                for q in range(3):
+                    rows[k] = 3 * i + p
+                    cols[k] = 3 * j + q
+                    vals[k] = g * u[p] * u[q] + (f if p == q else 0.0)
+                    k += 1
+    return rows, cols, vals

@@ -32,6 +32,16 @@ class Mobility:
     def matrix(self, x: np.ndarray) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
 
+    def near_field(self, x: np.ndarray, width: int):
+        """Sparse (CSR) part of the mobility between beads at most ``width`` apart."""
+        import scipy.sparse as sp
+
+        n = 3 * len(x)
+        if not self.long_range:
+            return sp.identity(n, format="csr") * self.self_mobility
+        r, c, v = K.rpy_band_coo(np.ascontiguousarray(x, dtype=np.float64), self.radius, int(width))
+        return sp.csr_matrix((v, (r, c)), shape=(n, n))
+
 
 class RPYMobility(Mobility):
     """Full Rotne-Prager-Yamakawa mobility (paper, Methods), numba O(n^2)."""
@@ -40,6 +50,7 @@ class RPYMobility(Mobility):
 
     def __init__(self, radius: float):
         self.radius = float(radius)
+        self.self_mobility = 1.0 / (6.0 * math.pi * self.radius)
 
     def apply(self, x, F):
         x = np.ascontiguousarray(x, dtype=np.float64)

@@ -1,0 +1,94 @@
+"""Linear solvers for the Rosenbrock stage equations ``W u = r``, ``W = I - gamma h Mob J``.
+
+* :class:`DenseW` assembles ``W`` (ny x ny) and LU-factorises it once per step: fastest for
+  small chains (N ~ 60 -> ny ~ 240), O(N^3) time and O(N^2) memory.
+* :class:`KrylovW` never forms a dense matrix: ``J`` is sparse (banded, from the coloured
+  Jacobian), ``Mob`` is applied matrix-free (O(N^2) RPY product, O(N) memory) and GMRES is
+  preconditioned by the near-field operator ``I - gamma h Mob_near J`` (sparse LU). Used for
+  long chains. The preconditioner keeps the near-field hydrodynamics (bead pairs within
+  ``4a/b + 4`` along the chain), which governs the stiff short-wavelength modes: with the self
+  mobility alone GMRES needed >100 iterations at N = 241 (overlapping beads).
+
+``make_w(kind, ...)`` picks one; ``"auto"`` switches at ``ny > 4000`` (N ~ 1000), a crossover
+measured in benchmarks/scaling.py.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+AUTO_CROSSOVER_NY = 4000
+
+
+class SingularW(Exception):
+    pass
+
+
+class DenseW:
+    def __init__(self, system, y, base, G0, gamma_h):
+        J = system.force_jacobian(y, base, G0)
+        Mob = system.mobility_matrix(y)
+        W = np.eye(system.ny) - gamma_h * (Mob @ J)
+        try:
+            self.lu = sla.lu_factor(W, check_finite=False)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            raise SingularW(str(exc)) from None
+        if not np.all(np.isfinite(self.lu[0])):
+            raise SingularW("non-finite LU")
+
+    def solve(self, rhs):
+        return sla.lu_solve(self.lu, rhs, check_finite=False)
+
+
+class KrylovW:
+    """Matrix-free ``W`` with a sparse local-drag preconditioner (GMRES, relative tol ``rtol``)."""
+
+    def __init__(self, system, y, base, G0, gamma_h, rtol=1e-10, maxiter=200):
+        import scipy.sparse as sp
+        import scipy.sparse.linalg as spla
+
+        self.system = system
+        self.y = y
+        self.gh = gamma_h
+        self.rtol = rtol
+        self.maxiter = maxiter
+        self.J = system.force_jacobian_sparse(y, base, G0)
+        Mnear = system.near_field_mobility(y)
+        P = sp.identity(system.ny, format="csc") - gamma_h * (Mnear @ self.J).tocsc()
+        try:
+            self.P = spla.splu(P)
+        except RuntimeError as exc:
+            raise SingularW(str(exc)) from None
+        n = system.ny
+        self.A = spla.LinearOperator((n, n), matvec=self._matvec, dtype=float)
+        self.M = spla.LinearOperator((n, n), matvec=self.P.solve, dtype=float)
+        self.iterations = 0
+
+    def _matvec(self, v):
+        return v - self.gh * self.system.apply_mobility(self.y, self.J @ v)
+
+    def solve(self, rhs):
+        import scipy.sparse.linalg as spla
+
+        count = [0]
+
+        def cb(_):
+            count[0] += 1
+
+        u, info = spla.gmres(self.A, rhs, M=self.M, rtol=self.rtol, atol=0.0, restart=50,
+                             maxiter=self.maxiter, callback=cb, callback_type="pr_norm")
+        self.iterations += count[0]
+        if info != 0:
+            raise SingularW(f"GMRES did not converge ({info})")
+        return u
+
+
+def make_w(kind, system, y, base, G0, gamma_h):
+    if kind == "auto":
+        kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "krylov"
+    if kind == "dense":
+        return DenseW(system, y, base, G0, gamma_h)
+    if kind == "krylov":
+        return KrylovW(system, y, base, G0, gamma_h)
+    raise ValueError(f"unknown linear solver {kind!r}")
