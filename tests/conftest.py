@@ -22,3 +22,35 @@ def make_config(machin=283.0, protocol=(("ccw", 10), ("cw", 10)), hi=True, **kw)
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+def tiny_toml(ccw=0.2, cw=0.2, n_beads=21, machin=100):
+    """A 21-bead Fig. 4(a)-like case that runs in well under a second (loose tol 1e-3)."""
+    return f"""
+name = "tiny"
+[filament]
+length = 0.4
+helix_radius = 0.03
+turns = 2
+cross_section_radius = 0.0015
+youngs_modulus = 1.5e6
+n_beads = {n_beads}
+[motor]
+machin = {machin}
+protocol = [{{direction = "ccw", turns = {ccw}}}, {{direction = "cw", turns = {cw}}}]
+[numerics]
+save_every = 0.05
+tol = 1e-3
+"""
+
+
+@pytest.fixture(scope="session")
+def tiny_run(tmp_path_factory):
+    """Run file of :func:`tiny_toml` (read-only for the tests that share it)."""
+    from flagwrap.io.config import config_from_dict, tomllib
+    from flagwrap.io.runfile import write_run
+    from flagwrap.simulation import simulate
+
+    path = tmp_path_factory.mktemp("tiny") / "tiny.nc"
+    write_run(simulate(config_from_dict(tomllib.loads(tiny_toml()))), path)
+    return path

@@ -212,7 +212,7 @@ class RodSystem:
     # Jacobian by coloured finite differences ------------------------------------------------
     def _build_colors(self):
         """Groups of columns whose force stencils are disjoint (5 apart along the chain)."""
-        nb, ne, nc, ec = self.nb, self.ne, self.nc, self.ec
+        nb, nc, ec = self.nb, self.nc, self.ec
         groups = []
 
         def bead_rows(k):  # k: full bead index; rows affected: beads k-2..k+2, bonds k-2..k+1

@@ -11,22 +11,9 @@ from flagwrap.analysis import STATES
 from flagwrap.cli.main import main
 from flagwrap.io.runfile import config_of, read_run
 
-TINY = """
-name = "tiny"
-[filament]
-length = 0.4
-helix_radius = 0.03
-turns = 2
-cross_section_radius = 0.0015
-youngs_modulus = 1.5e6
-n_beads = 21
-[motor]
-machin = 100
-protocol = [{direction = "ccw", turns = 0.3}, {direction = "cw", turns = 0.3}]
-[numerics]
-save_every = 0.05
-tol = 1e-3
-"""
+from conftest import tiny_toml
+
+TINY = tiny_toml(ccw=0.3, cw=0.3)
 
 
 @pytest.fixture(scope="module")

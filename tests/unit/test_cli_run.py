@@ -8,22 +8,9 @@ import numpy as np
 from flagwrap.cli.main import main
 from flagwrap.io.runfile import config_of, read_run
 
-TINY = """
-name = "tiny"
-[filament]
-length = 0.4
-helix_radius = 0.03
-turns = 2
-cross_section_radius = 0.0015
-youngs_modulus = 1.5e6
-n_beads = 21
-[motor]
-machin = 100
-protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.5}]
-[numerics]
-save_every = 0.05
-tol = 1e-3
-"""
+from conftest import tiny_toml
+
+TINY = tiny_toml(ccw=0.2, cw=0.5)
 
 
 def test_run_writes_self_describing_file(tmp_path):

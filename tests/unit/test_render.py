@@ -4,35 +4,10 @@ import numpy as np
 import pytest
 
 from flagwrap.cli.main import main
-from flagwrap.io.config import config_from_dict, tomllib
-from flagwrap.io.runfile import read_run, write_run
+from flagwrap.io.runfile import read_run
 from flagwrap.plotting.render import (CAMERAS, Renderer, Scene, body_surface,
                                       resample_centerline, tube_faces, view_limits)
-from flagwrap.simulation import simulate
 
-TINY = """
-name = "tiny"
-[filament]
-length = 0.4
-helix_radius = 0.03
-turns = 2
-cross_section_radius = 0.0015
-youngs_modulus = 1.5e6
-n_beads = 21
-[motor]
-machin = 100
-protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.2}]
-[numerics]
-save_every = 0.05
-tol = 1e-3
-"""
-
-
-@pytest.fixture(scope="module")
-def tiny_run(tmp_path_factory):
-    path = tmp_path_factory.mktemp("render") / "tiny.nc"
-    write_run(simulate(config_from_dict(tomllib.loads(TINY))), path)
-    return path
 
 
 def test_body_mesh_is_closed_with_outward_normals():

@@ -3,33 +3,8 @@
 import numpy as np
 import pytest
 
-from flagwrap.io.config import config_from_dict, tomllib
-from flagwrap.io.runfile import read_run, write_run
-from flagwrap.simulation import simulate
+from flagwrap.io.runfile import read_run
 
-TINY = """
-name = "tiny"
-[filament]
-length = 0.4
-helix_radius = 0.03
-turns = 2
-cross_section_radius = 0.0015
-youngs_modulus = 1.5e6
-n_beads = 21
-[motor]
-machin = 100
-protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.2}]
-[numerics]
-save_every = 0.05
-tol = 1e-3
-"""
-
-
-@pytest.fixture(scope="module")
-def tiny_run(tmp_path_factory):
-    path = tmp_path_factory.mktemp("vtk") / "tiny.nc"
-    write_run(simulate(config_from_dict(tomllib.loads(TINY))), path)
-    return path
 
 
 def _helix(handed=+1, n=80, R=0.03, pitch=0.07, turns=2.0):

@@ -23,8 +23,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -81,19 +79,6 @@ def annotate(ds, analysis: BucklingAnalysis):
     return out
 
 
-def _write_atomic(ds, path: Path) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        ds.to_netcdf(tmp, engine="h5netcdf")
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-
-
 def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool = True) -> dict:
     """Analyse the run file ``path``; store the results in it unless ``write`` is false.
 
@@ -107,13 +92,13 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
     UserInputError
         unreadable file, no CW phase, no cell body, too few frames.
     """
-    from flagwrap.io.runfile import read_run
+    from flagwrap.io.runfile import read_run, write_dataset_atomic
 
     path = Path(path)
     ds = read_run(path)
     a = analyze_dataset(ds, analysis)
     if write:
-        _write_atomic(annotate(ds, a), path)
+        write_dataset_atomic(annotate(ds, a), path)
     res = a.summary()
     res["params"] = a.params()
     res["path"] = str(path)

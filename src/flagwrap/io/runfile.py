@@ -106,11 +106,10 @@ def trajectory_dataset(traj):
     return ds
 
 
-def write_run(traj, path) -> Path:
-    """Write a trajectory atomically to ``path`` (netCDF4/HDF5)."""
+def write_dataset_atomic(ds, path) -> Path:
+    """Write an xarray dataset to ``path`` via a temporary file, fsync and rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    ds = trajectory_dataset(traj)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
@@ -122,6 +121,11 @@ def write_run(traj, path) -> Path:
         if os.path.exists(tmp):
             os.unlink(tmp)
     return path
+
+
+def write_run(traj, path) -> Path:
+    """Write a trajectory atomically to ``path`` (netCDF4/HDF5)."""
+    return write_dataset_atomic(trajectory_dataset(traj), path)
 
 
 def read_run(path):
