@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flagwrap.integrators import ROS2, ROS34PW2, ExplicitEuler
-from flagwrap.integrators.linear import DenseW, KrylovW
+from flagwrap.integrators.linear import DenseW, KrylovW, SparseW
 from flagwrap.integrators.ros34pw2 import A_T, C_T, GAMMA, M_T
 from flagwrap.model import RodSystem
 
@@ -135,3 +135,14 @@ def test_sparse_and_dense_jacobians_agree():
     Js = s.force_jacobian_sparse(y, info.frames, info.G).toarray()
     # same triplets; only the summation order of duplicate entries differs
     np.testing.assert_allclose(Jd, Js, rtol=1e-12, atol=1e-12 * np.abs(Jd).max())
+
+
+def test_sparse_solver_matches_dense_without_hydrodynamic_interactions():
+    cfg = make_config(machin=283, filament=paper_filament(n_beads=31), hi=False)
+    s = RodSystem(cfg)
+    y = s.initial_y()
+    info = s.forces(y, s.frames0)
+    r = np.random.default_rng(5).standard_normal(s.ny)
+    ud = DenseW(s, y, info.frames, info.G, 1e-2).solve(r)
+    us = SparseW(s, y, info.frames, info.G, 1e-2).solve(r)
+    assert np.abs(ud - us).max() <= 1e-9 * np.abs(ud).max()

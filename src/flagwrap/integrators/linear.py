@@ -9,6 +9,8 @@
   ``4a/b + 4`` along the chain), which governs the stiff short-wavelength modes: with the self
   mobility alone GMRES needed >100 iterations at N = 241 (overlapping beads).
 
+* :class:`SparseW` is the exact sparse LU when the mobility is local (HI off): banded, O(N).
+
 ``make_w(kind, ...)`` picks one; ``"auto"`` switches at ``ny > 4000`` (N ~ 1000), a crossover
 measured in benchmarks/scaling.py.
 """
@@ -84,9 +86,38 @@ class KrylovW:
         return u
 
 
+class SparseW:
+    """Sparse direct solve for a local (diagonal) mobility: ``W`` is banded, O(N) to factorise.
+
+    Exact when the long-range hydrodynamics is off (the paper's "without HIs" runs).
+    """
+
+    def __init__(self, system, y, base, G0, gamma_h):
+        import scipy.sparse as sp
+        import scipy.sparse.linalg as spla
+
+        if system.mobility.long_range:
+            raise ValueError("SparseW needs a local mobility (numerics.hydrodynamics = false)")
+        J = system.force_jacobian_sparse(y, base, G0)
+        d = system.local_mobility_diagonal()
+        W = sp.identity(system.ny, format="csc") - gamma_h * (sp.diags(d) @ J).tocsc()
+        try:
+            self.lu = spla.splu(W)
+        except RuntimeError as exc:
+            raise SingularW(str(exc)) from None
+
+    def solve(self, rhs):
+        return self.lu.solve(rhs)
+
+
 def make_w(kind, system, y, base, G0, gamma_h):
     if kind == "auto":
-        kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "krylov"
+        if not system.mobility.long_range:
+            kind = "sparse"
+        else:
+            kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "krylov"
+    if kind == "sparse":
+        return SparseW(system, y, base, G0, gamma_h)
     if kind == "dense":
         return DenseW(system, y, base, G0, gamma_h)
     if kind == "krylov":
