@@ -150,3 +150,13 @@ def test_chunked_run_equals_full_run(cfg):
     assert a.ok and b.ok and len(a.t) == len(b.t)
     np.testing.assert_allclose(b.t, a.t, atol=1e-12)
     np.testing.assert_allclose(np.asarray(b.x), np.asarray(a.x), atol=1e-4)
+
+
+def test_failed_run_is_not_called_stable(tmp_path, cfg):
+    def failing(cfg, path):
+        return {"buckled": False, "waiting_time_turns": float("nan"), "state": "stable",
+                "run_status": "failed", "message": "bead 40 entered the cell body"}
+
+    s = CriticalSearch(cache=RunCache(tmp_path, runner=failing))
+    with pytest.raises(UserInputError, match="entered the cell body"):
+        s.compute(cfg)

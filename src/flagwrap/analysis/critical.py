@@ -73,6 +73,10 @@ class CriticalRun:
         cache key; the run file is ``<cache>/<key>.nc``.
     reused : bool
         taken from the cache (no simulation made by this search).
+    torque_peak : float
+        most negative CW motor torque ``N_m R / A`` of the run.
+    crossing : float
+        ``(t_x - t_s) / T``, the persistent 0.15 L threshold crossing (nan if stable).
     """
 
     machin: float
@@ -83,6 +87,7 @@ class CriticalRun:
     key: str
     reused: bool
     torque_peak: float = float("nan")
+    crossing: float = float("nan")
 
 
 def probe_config(cfg, machin: float, ccw_turns: float = 5.0, cw_turns: float = 10.0):
@@ -194,7 +199,7 @@ def simulate_and_analyse(cfg, path: Path, stop_after: float | None = 2.0) -> dic
     try:
         res = analyze_run_file(path)
     except UserInputError as exc:  # e.g. a run that failed before the CW phase
-        return {"buckled": False, "waiting_time_turns": float("nan"), "state": "failed",
+        return {"buckled": None, "waiting_time_turns": float("nan"), "state": "failed",
                 "run_status": traj.status, "message": f"{traj.message}; analysis: {exc}"}
     res["message"] = traj.message
     return res
@@ -241,10 +246,16 @@ class RunCache:
             v = res.get(k)
             return float("nan") if v is None else float(v)
 
+        status = str(res.get("run_status", ""))
+        if res.get("buckled") is None or (status not in ("completed", "") and not res["buckled"]):
+            # a run that stopped (guard tripped) before buckling has no verdict: never "stable"
+            raise UserInputError(f"test run at M = {cfg.machin:.6g} ({self.directory / key}.nc) "
+                                 f"failed without a buckling verdict: {res.get('message', status)}")
+
         return CriticalRun(machin=float(cfg.machin), buckled=bool(res["buckled"]),
                            waiting_time=num("waiting_time_turns"), state=str(res.get("state", "")),
-                           status=str(res.get("run_status", "")), key=key, reused=reused,
-                           torque_peak=num("torque_peak_reduced"))
+                           status=status, key=key, reused=reused,
+                           torque_peak=num("torque_peak_reduced"), crossing=num("crossing_turns"))
 
 
 class CriticalSearch:

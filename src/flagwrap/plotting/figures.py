@@ -208,7 +208,8 @@ def plot_fig4(runs, path=None):
     return fig
 
 
-def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_line=0.5):
+def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_line=0.5, title="",
+              crossing=None):
     """Paper Fig. 6: waiting time ``t_c/T`` against ``eps = (omega - omega_c)/omega_c``.
 
     Parameters
@@ -221,6 +222,9 @@ def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_l
         error bars of ``t_c/T``.
     c_line : float
         the paper's line ``c_line / eps`` (0.5).
+    crossing : array_like, optional
+        threshold-crossing times ``(t_x - t_s)/T`` of the same runs (open squares): an upper
+        bound of the onset, robust where the rise is oscillatory.
 
     Main axes linear (as the paper), inset log-log.
     """
@@ -234,7 +238,11 @@ def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_l
     ins = ax.inset_axes([0.52, 0.48, 0.44, 0.46])
     for a in (ax, ins):
         err = None if waiting_time_err is None else np.asarray(waiting_time_err, float)[ok]
-        a.errorbar(e[ok], t[ok], yerr=err, fmt="o", color="k", ms=4, label="flagwrap runs")
+        a.errorbar(e[ok], t[ok], yerr=err, fmt="o", color="k", ms=4, label=r"flagwrap $t_c$ (onset fit)")
+        if crossing is not None:
+            cx = np.asarray(crossing, float)
+            okx = np.isfinite(cx) & (e > 0) & (cx > 0)
+            a.plot(e[okx], cx[okx], "s", mfc="none", mec="C2", ms=5, label=r"flagwrap $t_x$ (0.15 L crossing)")
         a.plot(grid, c_line / grid, "--", color="C0", label=rf"paper: ${c_line:g}/\epsilon$")
         if fit is not None:
             a.plot(grid, fit.predict(grid), "-", color="C3",
@@ -247,16 +255,20 @@ def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_l
     ax.set_xlabel(r"$\epsilon = (\omega-\omega_c)/\omega_c$ [1] ($\omega_c$ of this model)")
     ax.set_ylabel(r"waiting time $t_c/T$ [motor turns]")
     top = np.nanmax(t[ok]) if ok.any() else 10.0
+    if crossing is not None and np.isfinite(np.asarray(crossing, float)).any():
+        top = max(top, np.nanmax(np.asarray(crossing, float)))
     ax.set_ylim(0, 1.15 * max(top, 1.0))
     ax.set_xlim(0, grid.max())
     ax.legend(loc="lower left", fontsize=7)
+    if title:
+        ax.set_title(title, fontsize=9)
     fig.tight_layout()
     if path is not None:
         save_png_pdf(fig, path)
     return fig
 
 
-def plot_figS7(runs, path=None):
+def plot_figS7(runs, path=None, title=""):
     """SI Fig. S7(a): free-end height against time after the switch for several speeds, ``t_c`` marked.
 
     Parameters
@@ -277,7 +289,7 @@ def plot_figS7(runs, path=None):
     ax.axvline(0, color="0.6", lw=0.8, ls=":")
     ax.set_xlabel(r"$(t - t_s)/T$ after the CCW$\to$CW switch [motor turns]")
     ax.set_ylabel(r"free-end height $[z(L)-z(0)]/L$ [1]")
-    ax.set_title(r"SI Fig. S7(a): $\psi$ = 70$^\circ$, n = 3 ($\blacktriangledown$ = $t_c$)", fontsize=9)
+    ax.set_title(r"SI Fig. S7(a) ($\blacktriangledown$ = $t_c$) " + title, fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
     if path is not None:
@@ -285,12 +297,19 @@ def plot_figS7(runs, path=None):
     return fig
 
 
+def _geometry_title(root, mc):
+    from flagwrap.analysis import paper_runs
+
+    fil = paper_runs._config(paper_runs.FIG6_GEOMETRY, root).filament
+    return rf"$\psi$ = {fil.pitch_angle_deg:.0f}$^\circ$, n = {fil.turns:g}, this model's $M_c$ = {mc:.0f}"
+
+
 def _fig6_data(root=".", on_run=None):
-    """Critical search of the n = 3 helix, then the waiting-time sweep and its fit."""
+    """Critical search of :data:`flagwrap.analysis.paper_runs.FIG6_GEOMETRY`, the sweep, the fit."""
     from flagwrap.analysis import paper_runs
     from flagwrap.analysis.waiting_time import PowerLawFit
 
-    mc = paper_runs.critical("movie7", root=root).machin_c
+    mc = paper_runs.critical(paper_runs.FIG6_GEOMETRY, root=root).machin_c
     rows = paper_runs.fig6_runs(mc, on_run=on_run, root=root)
     eps = np.array([r["eps"] for r in rows])
     tc = np.array([r["waiting_time"] for r in rows])
@@ -343,7 +362,8 @@ def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
     from flagwrap.analysis.waiting_time import PowerLawFit
 
     mc, rows, eps, tc, fit = _fig6_data(root)
-    fig = plot_fig6(eps, tc, fit)
+    cross = np.array([r["crossing"] for r in rows])
+    fig = plot_fig6(eps, tc, fit, title=_geometry_title(root, mc), crossing=cross)
     paths = _save(fig, Path(outdir), "fig6")
     _mpl().close(fig)
     fits = {}
@@ -352,6 +372,8 @@ def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
         fits["free_beta"] = fit.summary()
     if n_ok >= 2:
         fits["beta_1"] = PowerLawFit(fix_beta=1.0).compute(eps, tc).summary()
+    if np.isfinite(cross).sum() >= 3:
+        fits["crossing_free_beta"] = PowerLawFit().compute(eps, cross).summary()
     if n_ok >= 4:
         m = np.array([r["machin"] for r in rows])
         try:
@@ -366,9 +388,9 @@ def figS7(outdir: str | Path = "out/figures", root=".") -> list[Path]:
     """SI Fig. S7(a) (free-end height for several omega, t_c marked) from the Fig. 6 sweep runs."""
     from flagwrap.io.runfile import read_run
 
-    _, rows, _, _, _ = _fig6_data(root)
+    mc, rows, _, _, _ = _fig6_data(root)
     runs = [(r["omega_ratio"], read_run(r["path"]), r["waiting_time"]) for r in rows]
-    fig = plot_figS7(runs)
+    fig = plot_figS7(runs, title=_geometry_title(root, mc))
     paths = _save(fig, Path(outdir), "figS7")
     _mpl().close(fig)
     return paths
