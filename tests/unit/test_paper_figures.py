@@ -77,3 +77,13 @@ def _close():
     import matplotlib.pyplot as plt
 
     plt.close("all")
+
+
+def test_departure_time():
+    from flagwrap.analysis.waiting_time import departure_time
+
+    ds = fake_run(rise_at=1.0)  # linear rise of 0.35 L over 0.5 T starting 1 T after the switch
+    td = departure_time(ds)
+    # 1-turn centred mean reaches +0.05 L about half a window before the raw ramp does
+    assert 0.5 < td < 1.3
+    assert np.isnan(departure_time(fake_run()))

@@ -152,6 +152,28 @@ class PowerLawFit:
                 "residual_rms_log": self.residual_rms, "n": self.n, "fix_beta": self.fix_beta}
 
 
+def departure_time(ds, rise: float = 0.05) -> float:
+    """``(t_d - t_s) / T``: first time after the switch at which the 1-turn running mean of the
+    free-end height is ``rise`` (default 0.05 L) above the CCW baseline, with no hold.
+
+    A detector-light companion of ``t_c`` for rises that are oscillatory or stop half-way: it
+    is :class:`~flagwrap.analysis.buckling.WaitingTime` with ``threshold=rise``,
+    ``hold_turns=0``, ``onset="crossing"``. 0.05 L is above the 0.03 L re-twisting transient
+    right after the switch (docs/analysis.md). nan if the height never gets there.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        a run (:func:`flagwrap.io.runfile.read_run`).
+    """
+    from flagwrap.analysis.buckling import WaitingTime
+
+    x = ds["position"].values
+    h = (x[:, -1, 2] - x[:, 0, 2]) / float(ds.attrs["length"])
+    w = WaitingTime(threshold=rise, hold_turns=0.0, onset="crossing")
+    return float(w.compute(ds["turns"].values, h, ds["omega"].values).waiting_time)
+
+
 def default_cw_turns(eps: float, c: float = 0.5, minimum: float = 10.0, margin: float = 5.0) -> float:
     """CW turns long enough to see an onset at ``t_c ~ 3 c / eps``: ``max(minimum, 3c/eps + margin)``."""
     return float(max(minimum, math.ceil(3.0 * c / eps + margin)))

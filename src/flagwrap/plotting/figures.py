@@ -209,7 +209,7 @@ def plot_fig4(runs, path=None):
 
 
 def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_line=0.5, title="",
-              crossing=None):
+              crossing=None, departure=None):
     """Paper Fig. 6: waiting time ``t_c/T`` against ``eps = (omega - omega_c)/omega_c``.
 
     Parameters
@@ -225,6 +225,9 @@ def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_l
     crossing : array_like, optional
         threshold-crossing times ``(t_x - t_s)/T`` of the same runs (open squares): an upper
         bound of the onset, robust where the rise is oscillatory.
+    departure : array_like, optional
+        departure times ``(t_d - t_s)/T`` (1-turn mean 0.05 L above the CCW baseline, no hold;
+        :func:`flagwrap.analysis.waiting_time.departure_time`), open triangles.
 
     Main axes linear (as the paper), inset log-log.
     """
@@ -232,7 +235,7 @@ def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_l
     e = np.asarray(eps, float)
     t = np.asarray(waiting_time, float)
     ok = np.isfinite(e) & np.isfinite(t) & (e > 0)
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    fig, ax = plt.subplots(figsize=(5.5, 5.2))
     grid = np.geomspace(max(min(e[ok].min(), 0.05) * 0.8, 1e-3), max(e[ok].max(), 2.0) * 1.1, 200) if ok.any() \
         else np.geomspace(0.04, 2.2, 200)
     ins = ax.inset_axes([0.52, 0.48, 0.44, 0.46])
@@ -243,6 +246,10 @@ def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_l
             cx = np.asarray(crossing, float)
             okx = np.isfinite(cx) & (e > 0) & (cx > 0)
             a.plot(e[okx], cx[okx], "s", mfc="none", mec="C2", ms=5, label=r"flagwrap $t_x$ (0.15 L crossing)")
+        if departure is not None:
+            dp = np.asarray(departure, float)
+            okd = np.isfinite(dp) & (e > 0) & (dp > 0)
+            a.plot(e[okd], dp[okd], "^", mfc="none", mec="C4", ms=5, label=r"flagwrap $t_d$ (0.05 L departure)")
         a.plot(grid, c_line / grid, "--", color="C0", label=rf"paper: ${c_line:g}/\epsilon$")
         if fit is not None:
             a.plot(grid, fit.predict(grid), "-", color="C3",
@@ -259,7 +266,7 @@ def plot_fig6(eps, waiting_time, fit=None, path=None, waiting_time_err=None, c_l
         top = max(top, np.nanmax(np.asarray(crossing, float)))
     ax.set_ylim(0, 1.15 * max(top, 1.0))
     ax.set_xlim(0, grid.max())
-    ax.legend(loc="lower left", fontsize=7)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=7)
     if title:
         ax.set_title(title, fontsize=9)
     fig.tight_layout()
@@ -362,8 +369,14 @@ def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
     from flagwrap.analysis.waiting_time import PowerLawFit
 
     mc, rows, eps, tc, fit = _fig6_data(root)
+    from flagwrap.analysis.waiting_time import departure_time
+    from flagwrap.io.runfile import read_run
+
     cross = np.array([r["crossing"] for r in rows])
-    fig = plot_fig6(eps, tc, fit, title=_geometry_title(root, mc), crossing=cross)
+    depart = np.array([departure_time(read_run(r["path"])) for r in rows])
+    for r, d in zip(rows, depart):
+        r["departure"] = float(d)
+    fig = plot_fig6(eps, tc, fit, title=_geometry_title(root, mc), crossing=cross, departure=depart)
     paths = _save(fig, Path(outdir), "fig6")
     _mpl().close(fig)
     fits = {}
@@ -374,6 +387,8 @@ def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
         fits["beta_1"] = PowerLawFit(fix_beta=1.0).compute(eps, tc).summary()
     if np.isfinite(cross).sum() >= 3:
         fits["crossing_free_beta"] = PowerLawFit().compute(eps, cross).summary()
+    if np.isfinite(depart).sum() >= 3:
+        fits["departure_free_beta"] = PowerLawFit().compute(eps, depart).summary()
     if n_ok >= 4:
         m = np.array([r["machin"] for r in rows])
         try:
