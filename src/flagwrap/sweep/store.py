@@ -1,0 +1,155 @@
+"""Hashed case store of a sweep: one run file and one row file per case, written atomically.
+
+Layout of ``out/sweeps/<name>/``::
+
+    runs/<key>.nc          the run file (flagwrap.io.runfile, atomic rename)
+    rows/<key>.json        the case's row: parameters, status, class, t_c, error (atomic rename)
+    boundary/<gkey>.json   boundary mode: M_c bracket of one geometry (atomic rename)
+    critical/              boundary mode: the analysis.critical run cache of the searches
+    table.parquet|.csv     the table of all rows, rewritten at the end of each sweep
+
+A row is written with ``tempfile`` + ``fsync`` + ``os.replace`` into ``rows/``: after a
+SIGKILL at any instant a row exists complete or not at all, and one file per key makes a
+duplicated row impossible. Nothing is appended in place. The table is built by reading every
+row (:meth:`SweepStore.table`); the exported file is only a convenience copy.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+#: columns that differ between two runs of the same case (timing, host); excluded from
+#: :meth:`SweepStore.table` with ``volatile=False``
+VOLATILE = ("wall_time_s", "finished_at", "host", "run_file")
+
+
+def write_json_atomic(obj, path) -> Path:
+    """Write ``obj`` as JSON to ``path`` via a temporary file in the same folder, fsync, rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(obj, fh, sort_keys=True, indent=1, allow_nan=False)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def jsonable(obj):
+    """NaN/inf -> None, numpy scalars -> Python, recursively."""
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if hasattr(obj, "item") and not isinstance(obj, (str, bytes)):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, (bool, int, float, str)) or obj is None:
+        return obj
+    return str(obj)
+
+
+class SweepStore:
+    """The folder of one sweep (see the module docstring).
+
+    Parameters
+    ----------
+    root : path-like
+        ``out/sweeps/<name>``; created on first write.
+    """
+
+    def __init__(self, root):
+        self.root = Path(root)
+        self.runs = self.root / "runs"
+        self.rows = self.root / "rows"
+        self.boundary = self.root / "boundary"
+        self.critical = self.root / "critical"
+
+    def run_path(self, key: str) -> Path:
+        return self.runs / f"{key}.nc"
+
+    def row_path(self, key: str) -> Path:
+        return self.rows / f"{key}.json"
+
+    def has_row(self, key: str) -> bool:
+        return self.row_path(key).is_file()
+
+    def read_row(self, key: str) -> dict | None:
+        p = self.row_path(key)
+        return json.loads(p.read_text()) if p.is_file() else None
+
+    def write_row(self, row: dict) -> Path:
+        """Write ``row`` (must hold ``key``) atomically to ``rows/<key>.json``."""
+        return write_json_atomic(jsonable(row), self.row_path(row["key"]))
+
+    def write_boundary(self, gkey: str, result: dict) -> Path:
+        return write_json_atomic(jsonable(result), self.boundary / f"{gkey}.json")
+
+    def clean(self) -> int:
+        """Remove temporary files left by a killed writer; returns how many."""
+        n = 0
+        for d in (self.runs, self.rows, self.boundary, self.critical):
+            if d.is_dir():
+                for p in d.glob(".*.tmp"):
+                    p.unlink(missing_ok=True)
+                    n += 1
+        return n
+
+    def iter_rows(self):
+        """Every complete row (sorted by key)."""
+        if not self.rows.is_dir():
+            return
+        for p in sorted(self.rows.glob("*.json")):
+            yield json.loads(p.read_text())
+
+    def boundaries(self) -> list[dict]:
+        if not self.boundary.is_dir():
+            return []
+        return [json.loads(p.read_text()) for p in sorted(self.boundary.glob("*.json"))]
+
+    def table(self, volatile: bool = True):
+        """All rows as a ``pandas.DataFrame`` sorted by key (``volatile=False`` drops the
+        timing/host columns :data:`VOLATILE`, which differ between two runs of a case)."""
+        import pandas as pd
+
+        df = pd.DataFrame(list(self.iter_rows()))
+        if len(df):
+            df = df.sort_values("key").reset_index(drop=True)
+            df = df[sorted(df.columns)]
+            if not volatile:
+                df = df.drop(columns=[c for c in VOLATILE if c in df.columns])
+        return df
+
+    def export(self) -> Path:
+        """Write the table to ``table.parquet`` if pyarrow is installed, else ``table.csv``
+        (atomic)."""
+        df = self.table()
+        try:
+            import pyarrow  # noqa: F401
+
+            path, kind = self.root / "table.parquet", "parquet"
+        except ModuleNotFoundError:
+            path, kind = self.root / "table.csv", "csv"
+        self.root.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.root)
+        os.close(fd)
+        try:
+            if kind == "parquet":
+                df.to_parquet(tmp, index=False)
+            else:
+                df.to_csv(tmp, index=False)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        return path

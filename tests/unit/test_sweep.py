@@ -1,0 +1,236 @@
+"""Sweeps (issue 5): spec -> cases, case keys, atomic rows, resume after SIGKILL, failed cases,
+LocalCluster vs in-process identical tables, boundary bisection.
+
+Oracle for the physics-free parts: a fake case function (``fake_sweep_runner.run``, written to
+a temporary folder and put on the path of this process and of every worker/subprocess) whose
+verdict is ``buckled <=> M > 0.2 (R/L)^-3`` and which raises for ``M > 1e5``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from flagwrap.errors import UserInputError
+from flagwrap.sweep.spec import Case, resolve_geometry, spec_from_dict
+
+FAKE = textwrap.dedent('''
+    import os, time
+    def run(cfg, path, stop_after):
+        log = os.environ.get("FAKE_SWEEP_LOG")
+        if log:
+            with open(log, "a") as fh:
+                fh.write(f"{cfg.machin:.9g} {cfg.filament.helix_radius:.9g}\\n")
+        time.sleep(float(os.environ.get("FAKE_SWEEP_SLEEP", "0")))
+        if cfg.machin > 1e5:
+            raise RuntimeError(f"boom: M = {cfg.machin:.6g} is too large")
+        rl = cfg.filament.helix_radius / cfg.filament.length
+        buckled = cfg.machin > 0.2 * rl ** -3
+        return {"buckled": buckled, "state": ("wrapping" if rl > 0.05 else "folding") if buckled else "stable",
+                "waiting_time_turns": 1.5 if buckled else float("nan"), "run_status": "completed",
+                "message": ""}
+''')
+
+
+@pytest.fixture
+def fake(tmp_path, monkeypatch):
+    d = tmp_path / "fakemod"
+    d.mkdir()
+    (d / "fake_sweep_runner.py").write_text(FAKE)
+    monkeypatch.syspath_prepend(str(d))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(d), os.environ.get("PYTHONPATH", "")]))
+    return "fake_sweep_runner:run"
+
+
+def _spec(runner, **extra):
+    d = {"name": "t", "runner": runner, "base": {"filament": {"n_beads": 21}},
+         "grid": {"psi_deg": [40.0, 70.0], "turns": [2.0, 3.0], "omega_ratio_scaling": [1.0, 5.0]}}
+    d.update(extra)
+    return spec_from_dict(d)
+
+
+def test_geometry_from_two_of_three():
+    psi, n, rl = resolve_geometry(70.0, 2.0, None)
+    assert rl == pytest.approx(math.sin(math.radians(70)) / (4 * math.pi))
+    assert resolve_geometry(70.0, None, rl)[1] == pytest.approx(2.0)
+    assert resolve_geometry(None, 2.0, rl)[0] == pytest.approx(70.0)
+    with pytest.raises(UserInputError, match="inconsistent"):
+        resolve_geometry(60.0, 2.0, rl)
+    with pytest.raises(UserInputError, match="two of"):
+        resolve_geometry(70.0, None, None)
+
+
+def test_case_config_matches_geometry():
+    c = spec_from_dict({"grid": {"psi_deg": 70.0, "turns": 2.0, "machin": 283.0}}).cases[0]
+    cfg = c.config()
+    assert cfg.filament.pitch_angle_deg == pytest.approx(70.0)
+    assert cfg.filament.turns == pytest.approx(2.0)
+    assert cfg.filament.cross_section_radius / cfg.filament.length == pytest.approx(1.5 / 400)
+    assert cfg.machin == pytest.approx(283.0)
+    assert cfg.body.radius_ratio == 0.6 and cfg.numerics.hydrodynamics
+
+
+def test_grid_expansion_and_speeds():
+    s = spec_from_dict({"grid": {"psi_deg": [40.0, 70.0], "turns": [2.0, 3.0],
+                                 "omega_ratio_scaling": [1.0, 2.0, 4.0], "hi": [True, False]}})
+    assert len(s.cases) == 2 * 2 * 3 * 2
+    for c in s.cases:
+        assert c.machin == pytest.approx(c.omega_ratio_scaling * 0.06 * c.r_over_l ** -3)
+    with pytest.raises(UserInputError, match="exactly one of machin"):
+        spec_from_dict({"grid": {"psi_deg": 70.0, "turns": 2.0}})
+    with pytest.raises(UserInputError, match="unknown key"):
+        spec_from_dict({"grid": {"psi_deg": 70.0, "turns": 2.0, "machin": 1.0, "colour": 1}})
+
+
+def test_key_is_hash_of_sorted_json():
+    c = spec_from_dict({"grid": {"psi_deg": 70.0, "turns": 2.0, "machin": 283.0}}).cases[0]
+    text = json.dumps(c.hash_payload(), sort_keys=True, separators=(",", ":"))
+    assert c.key == hashlib.sha256(text.encode()).hexdigest()[:16]
+    assert c.hash_payload()["version"]
+    assert c.with_machin(284.0).key != c.key
+    import dataclasses
+
+    assert dataclasses.replace(c, hi=False).key != c.key
+    assert dataclasses.replace(c, base={"filament": {"n_beads": 31}}).key != c.key
+    assert Case(**{f.name: getattr(c, f.name) for f in dataclasses.fields(c)}).key == c.key
+
+
+def test_failed_case_is_recorded_and_sweep_goes_on(tmp_path, fake):
+    from flagwrap.sweep.runner import run_sweep
+    from flagwrap.sweep.store import SweepStore
+
+    spec = _spec(fake, cases=[{"psi_deg": 70.0, "turns": 2.0, "machin": 2e5}])
+    rep = run_sweep(spec, tmp_path / "s", scheduler="synchronous")
+    assert (rep.total, rep.finished, rep.failed) == (9, 8, 1)
+    df = SweepStore(tmp_path / "s").table()
+    bad = df[df.status == "failed"]
+    assert len(bad) == 1 and "RuntimeError: boom: M = 200000" in bad.error.iloc[0]
+    assert set(df[df.status == "ok"].state) <= {"stable", "wrapping", "folding"}
+    assert rep.table_path.is_file()
+    # re-run: nothing recomputed; --retry-failed recomputes only the failed one
+    rep2 = run_sweep(spec, tmp_path / "s", scheduler="synchronous")
+    assert (rep2.skipped, rep2.finished, rep2.failed) == (9, 0, 0)
+    rep3 = run_sweep(spec, tmp_path / "s", scheduler="synchronous", retry_failed=True)
+    assert (rep3.skipped, rep3.failed) == (8, 1)
+
+
+def test_sigkill_and_resume(tmp_path, fake):
+    spec = tmp_path / "kill.toml"
+    spec.write_text(textwrap.dedent(f'''
+        name = "kill"
+        runner = "{fake}"
+        [base]
+        filament = {{ n_beads = 21 }}
+        [grid]
+        psi_deg = [40.0, 55.0, 70.0]
+        turns = [2.0, 3.0]
+        omega_ratio_scaling = [1.0, 5.0]
+    '''))
+    out = tmp_path / "out"
+    rows = out / "kill" / "rows"
+    cmd = [sys.executable, "-m", "flagwrap.cli.main", "sweep", str(spec), "--scheduler",
+           "synchronous", "--out", str(out), "--no-progress"]
+    env = dict(os.environ, FAKE_SWEEP_SLEEP="0.4", FAKE_SWEEP_LOG=str(tmp_path / "log1"))
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    t0 = time.time()
+    while len(list(rows.glob("*.json"))) < 4 and time.time() - t0 < 60:
+        assert p.poll() is None, p.stderr.read().decode()
+        time.sleep(0.05)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    done = {json.loads(f.read_text())["key"]: json.loads(f.read_text()) for f in rows.glob("*.json")}
+    assert 4 <= len(done) < 12
+    env["FAKE_SWEEP_LOG"] = str(tmp_path / "log2")
+    env["FAKE_SWEEP_SLEEP"] = "0"
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    rerun = set((tmp_path / "log2").read_text().split("\n")) - {""}
+    finished_before = {f"{d['machin']:.9g} {d['r_over_l'] * 0.4:.9g}" for d in done.values()}
+    assert not rerun & finished_before  # nothing finished was recomputed
+    assert len(rerun) == 12 - len(done)
+    files = sorted(rows.glob("*"))
+    assert [f.suffix for f in files] == [".json"] * 12  # no temporary leftovers
+    from flagwrap.sweep.store import SweepStore
+
+    df = SweepStore(out / "kill").table()
+    assert len(df) == 12 and df.key.is_unique and (df.status == "ok").all()
+    for k, d in done.items():  # rows written before the kill are untouched
+        assert df.set_index("key").loc[k, "finished_at"] == d["finished_at"]
+
+
+def test_localcluster_and_synchronous_give_identical_tables(tmp_path, fake):
+    pytest.importorskip("dask.distributed")
+    import pandas.testing as pdt
+
+    from flagwrap.sweep.runner import run_sweep
+    from flagwrap.sweep.store import SweepStore
+
+    spec = _spec(fake, cases=[{"psi_deg": 70.0, "turns": 2.0, "machin": 2e5}])
+    run_sweep(spec, tmp_path / "sync", scheduler="synchronous")
+    rep = run_sweep(spec, tmp_path / "local", scheduler="local", n_workers=2)
+    assert (rep.finished, rep.failed) == (8, 1)
+    a = SweepStore(tmp_path / "sync").table(volatile=False)
+    b = SweepStore(tmp_path / "local").table(volatile=False)
+    pdt.assert_frame_equal(a, b)
+    assert len(a) == 9
+
+
+def test_boundary_mode_bisection(tmp_path, fake):
+    from flagwrap.sweep.boundary import brackets_from_rows
+    from flagwrap.sweep.runner import run_sweep
+    from flagwrap.sweep.store import SweepStore
+
+    spec = spec_from_dict({"name": "b", "mode": "boundary", "runner": fake,
+                           "base": {"filament": {"n_beads": 21}},
+                           "grid": {"psi_deg": [40.0, 70.0], "turns": [2.0, 3.0]},
+                           "boundary": {"rtol": 0.05, "guess_ratio": 1.0, "max_runs": 20}})
+    rep = run_sweep(spec, tmp_path / "b", scheduler="synchronous")
+    assert (rep.total, rep.finished, rep.failed) == (4, 4, 0)
+    store = SweepStore(tmp_path / "b")
+    res = store.boundaries()
+    for b in res:
+        truth = 0.2 * b["r_over_l"] ** -3
+        assert b["converged"]
+        assert b["bracket"][0] < truth <= b["bracket"][1]
+        assert b["n_runs"] <= 4 + math.ceil(math.log2(math.log(2) / math.log(1.05))) + 1
+    # every test run is also a row, and the rows give the same brackets
+    br = {round(b["r_over_l"], 9): b for b in brackets_from_rows(store.iter_rows())}
+    for b in res:
+        assert br[round(b["r_over_l"], 9)]["machin_c"] == pytest.approx(b["machin_c"])
+    n_rows = len(list(store.iter_rows()))
+    rep2 = run_sweep(spec, tmp_path / "b", scheduler="synchronous")
+    assert rep2.skipped == 4 and len(list(store.iter_rows())) == n_rows
+
+
+def test_cli_dry_run(tmp_path, capsys):
+    from flagwrap.cli.main import main
+
+    assert main(["sweep", "examples/sweeps/fig5-quick.toml", "--dry-run", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "36 cases" in out and out.count("todo") == 36
+
+
+@pytest.mark.parametrize("name", ["fig5.toml", "fig5-quick.toml"])
+def test_shipped_sweeps_parse(name):
+    from flagwrap.sweep.spec import load_spec
+
+    s = load_spec(Path("examples/sweeps") / name)
+    psi = [c.psi_deg for c in s.cases]
+    n = [c.turns for c in s.cases]
+    rl3 = [c.r_over_l ** 3 for c in s.cases]
+    assert min(psi) == pytest.approx(33.0) and max(psi) == pytest.approx(70.0)
+    assert min(n) == 1.5 and max(n) == 3.5
+    assert max(rl3) / min(rl3) >= 10
+    assert all(c.hi for c in s.cases)
+    for c in s.cases:
+        c.config()  # every geometry is a valid config (no self-overlap)
