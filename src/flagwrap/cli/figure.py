@@ -5,6 +5,8 @@ Figures (registry FIGURES, extended as figures are added):
         quasi-static bead simulation with moment-free ends (main text Fig. 3(b))
   fig4  torque (c), free-end height with/without HI (d), 3D tip path (e) of the Fig. 4(a)
         helix at omega/omega_c = 0.85, 2.05 (this model's omega_c; docs/critical.md)
+  fig5  stability diagram (R/L)^3 vs M from the sweep table (flagwrap sweep
+        examples/sweeps/fig5.toml or fig5-quick.toml), scaling line 0.06 and our fit, bacteria
   fig6  waiting time t_c/T against eps with 0.5/eps, the fit and a log-log inset (n = 3)
   figS7 free-end height for several omega with t_c marked (SI Fig. S7(a), n = 3)
 
@@ -23,6 +25,12 @@ def _fig3(outdir):
     return fig3(outdir)
 
 
+def _fig5(outdir):
+    from flagwrap.plotting.diagram import fig5
+
+    return fig5(outdir)
+
+
 def _paper(name):
     def build(outdir):
         from flagwrap.plotting import figures
@@ -39,6 +47,8 @@ FIGURES = {
     "fig4": _paper("fig4"),
     "fig6": _paper("fig6"),
     "figS7": _paper("figS7"),
+    # issue 5: stability diagram from the sweep rows (out/sweeps/fig5, else fig5-quick)
+    "fig5": _fig5,
 }
 
 

@@ -1,0 +1,217 @@
+"""The stability diagram (paper Fig. 5) from sweep results, and the fit of its boundary.
+
+Axes as in the paper: ``(R/L)^3`` (abscissa) against ``M = eta omega L^4 / A`` (ordinate),
+both logarithmic. Symbols are THIS model's measured classes (docs/sweeps.md): open circle =
+stable (no buckling within the K CW turns), filled square = wrapping, filled circle = folding
+(buckled, not wrapped at the end of the run), colour = pitch angle psi; grey crosses = failed
+cases. Lines: the paper's scaling law ``M_c = 0.06 (R/L)^-3`` and our fit
+``M_c = c (R/L)^-beta`` to the per-geometry brackets (:func:`fit_boundary`); stars: the
+bacteria of the SI (``flagwrap.bacteria``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from flagwrap.errors import UserInputError
+
+PAPER_PREFACTOR = 0.06
+DEFAULT_SWEEPS = ("out/sweeps/fig5", "out/sweeps/fig5-quick")
+
+
+def fit_boundary(brackets) -> dict:
+    """Fit ``ln M_c = ln c - beta ln(R/L)`` to geometries with a two-sided bracket.
+
+    Each point is ``M_c = sqrt(M_lo M_hi)``; its standard deviation in ``ln M`` is the bracket's
+    log half-width over sqrt(3) (``M_c`` uniform in ``ln M`` inside the bracket), floored at
+    0.01. Weighted least squares (``scipy.optimize.curve_fit``) with the covariance scaled by
+    the reduced chi^2 (``absolute_sigma=False``): the scatter between geometries of equal R/L
+    but different psi, n is larger than the bracket widths, and this lets it set the errors.
+    Also the one-parameter fit with the paper's ``beta = 3``.
+
+    Parameters
+    ----------
+    brackets : list of dict
+        :func:`flagwrap.sweep.boundary.brackets_from_rows` output (other kinds are skipped).
+
+    Returns
+    -------
+    dict
+        ``n`` points; ``prefactor``, ``prefactor_err``, ``exponent`` (beta; the paper: 3),
+        ``exponent_err``, ``cov_lnc_beta``; ``prefactor_beta3``, ``prefactor_beta3_err``;
+        ``n_lower``/``n_upper`` (one-sided geometries, not fitted). nan where undefined
+        (beta needs >= 3 points at >= 2 distinct R/L).
+    """
+    from scipy.optimize import curve_fit
+
+    pts = [b for b in brackets if b.get("kind") == "bracket"]
+    out = {"n": len(pts), "n_lower": sum(b.get("kind") == "lower" for b in brackets),
+           "n_upper": sum(b.get("kind") == "upper" for b in brackets),
+           "prefactor": math.nan, "prefactor_err": math.nan, "exponent": math.nan,
+           "exponent_err": math.nan, "cov_lnc_beta": math.nan,
+           "prefactor_beta3": math.nan, "prefactor_beta3_err": math.nan}
+    if not pts:
+        return out
+    x = np.log([b["r_over_l"] for b in pts])
+    y = np.log([b["machin_c"] for b in pts])
+    s = np.maximum(np.array([b["sigma_ln"] for b in pts]) / math.sqrt(3), 0.01)
+    # beta = 3 fixed: ln c = weighted mean of y + 3 x
+    w = 1 / s**2
+    z = y + 3 * x
+    lnc3 = float(np.sum(w * z) / np.sum(w))
+    out["prefactor_beta3"] = math.exp(lnc3)
+    if len(pts) >= 2:
+        chi2 = float(np.sum(w * (z - lnc3) ** 2)) / (len(pts) - 1)
+        out["prefactor_beta3_err"] = math.exp(lnc3) * math.sqrt(max(chi2, 1e-300) / np.sum(w))
+    if len(pts) >= 3 and np.ptp(x) > 0:
+        (lnc, beta), cov = curve_fit(lambda xx, a, b: a - b * xx, x, y, p0=(lnc3, 3.0), sigma=s,
+                                     absolute_sigma=False)
+        out.update(prefactor=math.exp(lnc), prefactor_err=math.exp(lnc) * math.sqrt(cov[0, 0]),
+                   exponent=float(beta), exponent_err=math.sqrt(cov[1, 1]),
+                   cov_lnc_beta=float(cov[0, 1]))
+    return out
+
+
+def load_rows(sweep_dirs=None) -> tuple[list[dict], list[str]]:
+    """Rows of the first sweep folder in ``sweep_dirs`` that has any (default: out/sweeps/fig5,
+    then out/sweeps/fig5-quick). Returns ``(rows, [folders used])``."""
+    from flagwrap.sweep.store import SweepStore
+
+    dirs = list(sweep_dirs) if sweep_dirs is not None else list(DEFAULT_SWEEPS)
+    for d in dirs:
+        rows = list(SweepStore(d).iter_rows())
+        if rows:
+            return rows, [str(d)]
+    raise UserInputError(f"no sweep results in {', '.join(map(str, dirs))}: run "
+                         "`flagwrap sweep examples/sweeps/fig5-quick.toml` first")
+
+
+def classify(row: dict) -> str:
+    """``stable`` / ``wrapping`` / ``folding`` / ``failed`` for a diagram symbol."""
+    if row.get("status") != "ok" or row.get("buckled") is None:
+        return "failed"
+    if not row["buckled"]:
+        return "stable"
+    return "wrapping" if row.get("state") == "wrapping" else "folding"
+
+
+def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.0, 72.0)):
+    """Draw the diagram of ``rows`` on ``ax`` (new figure if None); returns the axes.
+
+    Parameters
+    ----------
+    rows : list of dict
+        sweep rows (``r_over_l_cubed``, ``machin``, ``psi_deg``, ``buckled``, ``state``).
+    species : list of flagwrap.bacteria.Species, optional
+        stars (default: the shipped table; ``[]`` for none).
+    fit : dict, optional
+        :func:`fit_boundary` result: its line is drawn if finite.
+    brackets : list of dict, optional
+        per-geometry brackets; two-sided ones are drawn as black bars (M_lo..M_hi).
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import Normalize
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.4, 5.0))
+    cmap, norm = plt.get_cmap("viridis"), Normalize(*psi_range)
+    styles = {"stable": dict(marker="o", filled=False), "wrapping": dict(marker="s", filled=True),
+              "folding": dict(marker="o", filled=True)}
+    labelled = set()
+    for r in rows:
+        kind = classify(r)
+        x, y = r["r_over_l_cubed"], r["machin"]
+        if kind == "failed":
+            ax.scatter([x], [y], marker="x", c="0.5", s=30, zorder=3,
+                       label=None if "failed" in labelled else "failed")
+        else:
+            col = cmap(norm(r["psi_deg"]))
+            st = styles[kind]
+            ax.scatter([x], [y], marker=st["marker"], s=36, zorder=3, linewidths=1.2,
+                       facecolors=col if st["filled"] else "none", edgecolors=col,
+                       label=None if kind in labelled else kind)
+        labelled.add(kind)
+    xs = np.array([r["r_over_l_cubed"] for r in rows] or [1e-5, 1e-3])
+    if species is None:
+        from flagwrap.bacteria import default_species
+
+        species = default_species()
+    for i, sp in enumerate(species):
+        ax.scatter([sp.radius_over_length_cubed], [sp.machin], marker="*", s=140, c="tab:red",
+                   edgecolors="k", linewidths=0.5, zorder=4, label="bacteria (SI)" if i == 0 else None)
+        xs = np.append(xs, sp.radius_over_length_cubed)
+    xline = np.logspace(np.log10(xs.min()) - 0.15, np.log10(xs.max()) + 0.15, 50)
+    ax.plot(xline, PAPER_PREFACTOR / xline, "k-", lw=1.5, label=r"paper: $M_c = 0.06\,(R/L)^{-3}$")
+    if brackets:
+        for b in brackets:
+            if b.get("kind") == "bracket":
+                ax.plot([b["r_over_l_cubed"]] * 2, [b["m_lo"], b["m_hi"]], "k-", lw=3, alpha=0.35,
+                        zorder=2)
+    if fit is not None:
+        if math.isfinite(fit.get("exponent", math.nan)):
+            c, be = fit["prefactor"], fit["exponent"]
+            ax.plot(xline, c * xline ** (-be / 3), "--", color="tab:red", lw=1.5,
+                    label=rf"fit: $M_c = {c:.3g}\,(R/L)^{{-{be:.2f}\pm{fit['exponent_err']:.2f}}}$")
+        if math.isfinite(fit.get("prefactor_beta3", math.nan)):
+            c3 = fit["prefactor_beta3"]
+            ax.plot(xline, c3 / xline, ":", color="tab:red", lw=1.5,
+                    label=rf"fit, exponent $-3$: $M_c = {c3:.3g}\,(R/L)^{{-3}}$")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(r"$(R/L)^3$")
+    ax.set_ylabel(r"$M = \eta\omega L^4/A$")
+    sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
+    ax.figure.colorbar(sm, ax=ax, label=r"pitch angle $\psi$ [deg]")
+    ax.legend(fontsize=7, loc="lower left")
+    return ax
+
+
+def fig5(outdir="out/figures", sweep_dirs=None) -> list:
+    """``flagwrap figure fig5``: the diagram from the sweep table (PNG + PDF) and the fit (JSON).
+
+    Reads the rows of out/sweeps/fig5 (or, if it has none, out/sweeps/fig5-quick); writes
+    ``fig5.png``, ``fig5.pdf`` and ``fig5.json`` (fit, per-geometry brackets, sources).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flagwrap.sweep.boundary import brackets_from_rows
+    from flagwrap.sweep.store import jsonable, write_json_atomic
+
+    rows, used = load_rows(sweep_dirs)
+    brackets = brackets_from_rows(rows)
+    fit = fit_boundary(brackets)
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    fig, ax = plt.subplots(figsize=(6.8, 5.2))
+    diagram(rows, ax=ax, fit=fit, brackets=brackets)
+    n_beads = sorted({r.get("n_beads") for r in rows})
+    ax.set_title(f"stability diagram, this model ({len(rows)} runs, N = "
+                 f"{', '.join(map(str, n_beads))}; {Path(used[0]).name})", fontsize=9)
+    fig.tight_layout()
+    paths = [outdir / "fig5.png", outdir / "fig5.pdf"]
+    fig.savefig(paths[0], dpi=150)
+    fig.savefig(paths[1])
+    plt.close(fig)
+    counts = {}
+    for r in rows:
+        counts[classify(r)] = counts.get(classify(r), 0) + 1
+    info = {"sources": used, "n_rows": len(rows), "classes": counts, "fit": fit,
+            "paper": {"prefactor": PAPER_PREFACTOR, "exponent": 3.0}, "brackets": brackets}
+    paths.append(write_json_atomic(jsonable(info), outdir / "fig5.json"))
+    return [str(p) for p in paths]
+
+
+def format_fit(fit: dict) -> str:
+    """One line: the fitted prefactor and exponent against the paper's 0.06 and 3."""
+    return (f"M_c = c (R/L)^-beta: c = {fit['prefactor']:.3g} +- {fit['prefactor_err']:.2g}, "
+            f"beta = {fit['exponent']:.3g} +- {fit['exponent_err']:.2g} (paper: 0.06, 3); "
+            f"beta = 3 fixed: c = {fit['prefactor_beta3']:.3g} +- {fit['prefactor_beta3_err']:.2g}; "
+            f"{fit['n']} geometries with a bracket")
+
