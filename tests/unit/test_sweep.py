@@ -234,3 +234,20 @@ def test_shipped_sweeps_parse(name):
     assert all(c.hi for c in s.cases)
     for c in s.cases:
         c.config()  # every geometry is a valid config (no self-overlap)
+
+
+def test_real_tiny_case_writes_run_file_and_row(tmp_path):
+    """The default case function end to end (13 beads, 1 CCW + 1.5 CW turns, tol 1e-3)."""
+    from flagwrap.io.runfile import read_run
+    from flagwrap.sweep.runner import run_case
+    from flagwrap.sweep.store import SweepStore
+
+    s = spec_from_dict({"run": {"ccw_turns": 1.0, "cw_turns": 1.5},
+                        "base": {"filament": {"n_beads": 13}, "numerics": {"tol": 1e-3}},
+                        "grid": {"psi_deg": 70.0, "turns": 1.5, "omega_ratio_scaling": 2.0}})
+    row = run_case(s.cases[0], tmp_path)
+    assert row["status"] == "ok" and row["buckled"] is False and row["state"] == "stable"
+    assert row["run_status"] == "completed"
+    ds = read_run(row["run_file"])
+    assert ds.attrs.get("status") == "completed"
+    assert SweepStore(tmp_path).read_row(row["key"])["key"] == row["key"]

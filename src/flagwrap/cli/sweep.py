@@ -43,6 +43,18 @@ def run(args) -> int:
         raise UserInputError(f"--workers must be >= 1, got {args.workers}")
     root = Path(args.out) / spec.name
     store = SweepStore(root)
+    if args.dry_run and spec.mode == "boundary":
+        from flagwrap.sweep.boundary import geometry_key
+
+        geos = spec.geometries()
+        print(f"{spec.name}: {len(geos)} geometries, mode boundary, -> {root}")
+        for c in geos:
+            gk = geometry_key(c, spec.boundary)
+            done = (store.boundary / f"{gk}.json").is_file()
+            print(f"  {gk}  psi={c.psi_deg:5.1f} n={c.turns:4.2f} R/L={c.r_over_l:.4f} "
+                  f"first M={spec.boundary['guess_ratio'] * c.machin_scaling:9.2f} hi={c.hi}  "
+                  f"{'done' if done else 'todo'}")
+        return 0
     if args.dry_run:
         print(f"{spec.name}: {len(spec.cases)} cases, mode {spec.mode}, -> {root}")
         for c in spec.cases:

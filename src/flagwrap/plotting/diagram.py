@@ -20,7 +20,8 @@ import numpy as np
 from flagwrap.errors import UserInputError
 
 PAPER_PREFACTOR = 0.06
-DEFAULT_SWEEPS = ("out/sweeps/fig5", "out/sweeps/fig5-quick")
+#: sweep folders read by ``flagwrap figure fig5``: the first group that has rows
+DEFAULT_SWEEPS = (("out/sweeps/fig5",), ("out/sweeps/fig5-quick", "out/sweeps/fig5-boundary"))
 
 
 def fit_boundary(brackets) -> dict:
@@ -77,16 +78,23 @@ def fit_boundary(brackets) -> dict:
 
 
 def load_rows(sweep_dirs=None) -> tuple[list[dict], list[str]]:
-    """Rows of the first sweep folder in ``sweep_dirs`` that has any (default: out/sweeps/fig5,
-    then out/sweeps/fig5-quick). Returns ``(rows, [folders used])``."""
+    """Rows of the sweep folders ``sweep_dirs`` (union, one row per key). Default: the full
+    sweep out/sweeps/fig5 if it has rows, else out/sweeps/fig5-quick together with
+    out/sweeps/fig5-boundary (same reduced resolution). Returns ``(rows, [folders used])``."""
     from flagwrap.sweep.store import SweepStore
 
-    dirs = list(sweep_dirs) if sweep_dirs is not None else list(DEFAULT_SWEEPS)
-    for d in dirs:
-        rows = list(SweepStore(d).iter_rows())
+    groups = [list(sweep_dirs)] if sweep_dirs is not None else [list(g) for g in DEFAULT_SWEEPS]
+    for dirs in groups:
+        rows, used = {}, []
+        for d in dirs:
+            found = list(SweepStore(d).iter_rows())
+            if found:
+                used.append(str(d))
+            for r in found:
+                rows.setdefault(r["key"], r)
         if rows:
-            return rows, [str(d)]
-    raise UserInputError(f"no sweep results in {', '.join(map(str, dirs))}: run "
+            return [rows[k] for k in sorted(rows)], used
+    raise UserInputError(f"no sweep results in {', '.join(map(str, sum(groups, [])))}: run "
                          "`flagwrap sweep examples/sweeps/fig5-quick.toml` first")
 
 
@@ -173,7 +181,8 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
 def fig5(outdir="out/figures", sweep_dirs=None) -> list:
     """``flagwrap figure fig5``: the diagram from the sweep table (PNG + PDF) and the fit (JSON).
 
-    Reads the rows of out/sweeps/fig5 (or, if it has none, out/sweeps/fig5-quick); writes
+    Reads the rows of out/sweeps/fig5 (or, if it has none, out/sweeps/fig5-quick and
+    out/sweeps/fig5-boundary; :func:`load_rows`); writes
     ``fig5.png``, ``fig5.pdf`` and ``fig5.json`` (fit, per-geometry brackets, sources).
     """
     import matplotlib
@@ -193,7 +202,8 @@ def fig5(outdir="out/figures", sweep_dirs=None) -> list:
     diagram(rows, ax=ax, fit=fit, brackets=brackets)
     n_beads = sorted({r.get("n_beads") for r in rows})
     ax.set_title(f"stability diagram, this model ({len(rows)} runs, N = "
-                 f"{', '.join(map(str, n_beads))}; {Path(used[0]).name})", fontsize=9)
+                 f"{', '.join(map(str, n_beads))}; {' + '.join(Path(u).name for u in used)})",
+                 fontsize=9)
     fig.tight_layout()
     paths = [outdir / "fig5.png", outdir / "fig5.pdf"]
     fig.savefig(paths[0], dpi=150)
