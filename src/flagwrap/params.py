@@ -24,6 +24,8 @@ PAPER_MC_PREFACTOR = 0.06
 
 
 def _finite(name: str, value) -> float:
+    if isinstance(value, (bool, np.bool_)):
+        raise UserInputError(f"{name} must be a number, got {value!r}")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -103,25 +105,33 @@ class Filament:
                 "filament: give exactly one of pitch, pitch_angle_deg or turns "
                 f"(got {', '.join(given) if given else 'none'})"
             )
-        if given[0] == "pitch":
-            P = _positive("filament.pitch", self.pitch, "m")
-        elif given[0] == "pitch_angle_deg":
-            psi = _finite("filament.pitch_angle_deg", self.pitch_angle_deg)
-            if not 0.0 < psi < 90.0:
-                raise UserInputError(f"filament.pitch_angle_deg must be in (0, 90) deg, got {psi}")
-            P = 2 * math.pi * R / math.tan(math.radians(psi))
-        else:
-            n = _positive("filament.turns", self.turns)
-            per_turn = L / n
-            if per_turn <= 2 * math.pi * R:
-                raise UserInputError(
-                    f"filament.turns={n} needs a contour per turn L/n={per_turn:g} m longer than "
-                    f"2 pi R={2 * math.pi * R:g} m; allowed: turns < {L / (2 * math.pi * R):g}"
-                )
-            P = math.sqrt(per_turn**2 - (2 * math.pi * R) ** 2)
+        try:
+            if given[0] == "pitch":
+                P = _positive("filament.pitch", self.pitch, "m")
+            elif given[0] == "pitch_angle_deg":
+                psi = _finite("filament.pitch_angle_deg", self.pitch_angle_deg)
+                if not 0.0 < psi < 90.0:
+                    raise UserInputError(f"filament.pitch_angle_deg must be in (0, 90) deg, got {psi}")
+                P = 2 * math.pi * R / math.tan(math.radians(psi))
+            else:
+                n = _positive("filament.turns", self.turns)
+                per_turn = L / n
+                if per_turn <= 2 * math.pi * R:
+                    raise UserInputError(
+                        f"filament.turns={n} needs a contour per turn L/n={per_turn:g} m longer than "
+                        f"2 pi R={2 * math.pi * R:g} m; allowed: turns < {L / (2 * math.pi * R):g}"
+                    )
+                P = math.sqrt(per_turn**2 - (2 * math.pi * R) ** 2)
+            turns = L / math.hypot(2 * math.pi * R, P)
+        except (OverflowError, ZeroDivisionError):
+            P = turns = math.nan
+        if not (math.isfinite(P) and P > 0 and math.isfinite(turns) and turns > 0):
+            raise UserInputError(
+                f"filament: length={L:g} m, helix_radius={R:g} m and {given[0]}="
+                f"{getattr(self, given[0])!r} give no finite helix (values out of physical range)")
         _set(self, "pitch", P)
         _set(self, "pitch_angle_deg", math.degrees(math.atan2(2 * math.pi * R, P)))
-        _set(self, "turns", L / math.hypot(2 * math.pi * R, P))
+        _set(self, "turns", turns)
         if a >= R:
             raise UserInputError(
                 f"filament.cross_section_radius={a:g} m must be < helix_radius={R:g} m"
@@ -438,6 +448,20 @@ class Config:
                 f"initial helix self-overlaps: two non-neighbouring beads are {dmin:g} m apart, "
                 f"less than 2 a = {2 * fil.cross_section_radius:g} m (increase pitch or reduce a)"
             )
+        # derived scales must be finite and positive (extreme inputs can overflow or underflow)
+        derived = {}
+        for what in ("bending_modulus", "twist_modulus", "omega", "machin", "reynolds"):
+            try:
+                v = getattr(fil, what) if what.endswith("modulus") else getattr(self, what)
+            except (OverflowError, ZeroDivisionError):
+                v = math.nan
+            derived[what] = v
+            if not math.isfinite(v) or v < 0 or (v == 0 and what != "reynolds"):
+                raise UserInputError(
+                    f"derived {what} = {v!r} is not a finite positive number "
+                    f"({', '.join(f'{k} = {x:g}' for k, x in derived.items())}): the inputs "
+                    "(filament.youngs_modulus, cross_section_radius, length, fluid.viscosity, "
+                    "motor.machin/frequency) are out of physical range")
 
     # derived dimensionless numbers -------------------------------------------------------------
     @property

@@ -7,7 +7,17 @@ with a message, keeping everything computed so far, when a guard trips:
 
 * a non-finite state or a step size below ``numerics.dt_min``;
 * a bead inside the cell body;
-* a bond strain above ``max_strain`` (the springs are meant to be virtually inextensible).
+* a bond strain above ``max_strain`` (the springs are meant to be virtually inextensible);
+* non-finite generalized forces.
+
+The message names the time, the bead (or bond) and the quantity; the trajectory ends with the
+last frame that passed the guards.
+
+Checkpoints (:mod:`flagwrap.io.checkpoint`): with ``checkpoint_path`` set, the complete loop
+state is written atomically every ``checkpoint_every_steps`` accepted steps and/or every
+``checkpoint_every_seconds`` of wall time; ``run(resume=path)`` continues from one and
+reproduces the uninterrupted run bit for bit (the state includes the step-size controller's
+``h`` and the reference frames the forces were computed against).
 """
 
 from __future__ import annotations
@@ -61,10 +71,19 @@ class Simulation:
     """Owns the loop for one :class:`RodSystem` and one integrator."""
 
     def __init__(self, config, system: RodSystem | None = None, integrator=None,
-                 max_strain: float = 0.05):
+                 max_strain: float = 0.05, checkpoint_path=None, checkpoint_every_steps: int = 0,
+                 checkpoint_every_seconds: float = 0.0):
         if system is not None and system.config != config:
             raise ValueError("Simulation: system was built from a different config")
+        if system is None:
+            from flagwrap.resources import check_memory
+
+            check_memory(config)  # before building anything N^2-sized
         self.config = config
+        self.checkpoint_path = checkpoint_path
+        self.checkpoint_every_steps = int(checkpoint_every_steps or 0)
+        self.checkpoint_every_seconds = float(checkpoint_every_seconds or 0.0)
+        self._config_toml = None
         self.system = system or RodSystem(config)
         num = config.numerics
         self.integrator = integrator or make_integrator(num.integrator, num.tol)
@@ -99,30 +118,90 @@ class Simulation:
 
     def _guard(self, info) -> str:
         s = self.system
+        if not np.all(np.isfinite(info.G)):
+            k = int(np.flatnonzero(~np.isfinite(info.G))[0])
+            if k < s.sl_x.stop:
+                where = f"bead {s.nc + k // 3} (force component {'xyz'[k % 3]})"
+            else:
+                where = f"bond {s.ec + k - s.sl_th.start} (twist torque)"
+            return f"non-finite generalized force {info.G[k]} on {where}"
         if s.N > s.nc and np.min(info.distance[s.nc:]) <= 0.0:
             i = int(np.argmin(info.distance[s.nc:])) + s.nc
             return f"bead {i} entered the cell body (distance {info.distance[i]:.3g} L)"
         strain = np.abs(np.linalg.norm(np.diff(info.x, axis=0), axis=1) / s.rest.l0 - 1.0)
         if strain.max() > self.max_strain_limit:
             j = int(np.argmax(strain))
-            return (f"bond {j} strain {strain[j]:.3g} exceeds the limit {self.max_strain_limit:g} "
-                    "(stretching springs no longer inextensible)")
+            return (f"bond {j} (beads {j}-{j + 1}) strain {strain[j]:.3g} exceeds the limit "
+                    f"{self.max_strain_limit:g} (stretching springs no longer inextensible)")
         return ""
 
+    def _fastest(self, y, info) -> str:
+        """``"; fastest bead i (|dx/dt| = v L omega)"`` at the last good state (diagnostics)."""
+        s = self.system
+        try:
+            v = s.apply_mobility(y, info.G)[s.sl_x].reshape(-1, 3)
+            sp = np.linalg.norm(v, axis=1)
+            i = int(np.nanargmax(sp))
+            return f"; fastest bead {s.nc + i} (|dx/dt| = {sp[i]:.3g} L omega)"
+        except (ValueError, FloatingPointError):
+            return ""
+
+    def _checkpoint_toml(self) -> str:
+        if self._config_toml is None:
+            from flagwrap.io.config import config_to_toml
+
+            self._config_toml = config_to_toml(self.config)
+        return self._config_toml
+
+    def _write_checkpoint(self, traj, t, t_end, y, base_in, h, next_save, wall_time):
+        from flagwrap.io.checkpoint import Checkpoint, write_checkpoint
+
+        write_checkpoint(Checkpoint(
+            t=t, t_end=t_end, h=h, next_save=next_save, n_steps=traj.n_steps,
+            n_rejected=traj.n_rejected, wall_time=wall_time, y=y, base_t=base_in.t,
+            base_d1=base_in.d1, base_rt=base_in.rt, records=traj.arrays(),
+            config_toml=self._checkpoint_toml()), self.checkpoint_path)
+
     def run(self, t_end: float | None = None, progress: bool = False, y0=None,
-            base=None, t0: float = 0.0) -> Trajectory:
+            base=None, t0: float = 0.0, resume=None) -> Trajectory:
+        """Integrate from ``t0`` to ``t_end`` (default: the end of the motor protocol).
+
+        ``resume``: a checkpoint path (or :class:`~flagwrap.io.checkpoint.Checkpoint`) to
+        continue from instead of ``y0/base/t0``; it must come from the same config and version.
+        """
         s = self.system
         sched = s.schedule
-        t_end = sched.t_end if t_end is None else t_end
         traj = Trajectory(self.config)
-        y = s.initial_y() if y0 is None else np.array(y0, float)
-        base = (s.frames0.copy() if base is None else base)
-        info = s.forces(y, base)
+        wall0 = 0.0
+        if resume is not None:
+            from flagwrap.io.checkpoint import Checkpoint, check_compatible, read_checkpoint
+
+            ck = resume if isinstance(resume, Checkpoint) else read_checkpoint(resume)
+            check_compatible(ck, self.config, resume if not isinstance(resume, Checkpoint) else "checkpoint")
+            if t_end is not None and t_end != ck.t_end:
+                from flagwrap.errors import UserInputError
+
+                raise UserInputError(f"checkpoint runs to t={ck.t_end}, not the requested t_end={t_end}")
+            t_end, t, h, next_save = ck.t_end, ck.t, ck.h, ck.next_save
+            for k, v in ck.records.items():
+                getattr(traj, k).extend(list(v))
+            traj.n_steps, traj.n_rejected, wall0 = ck.n_steps, ck.n_rejected, ck.wall_time
+            y = ck.y.copy()
+            base_in = ck.base()
+            info = s.forces(y, base_in)
+            t0 = t
+        else:
+            t_end = sched.t_end if t_end is None else t_end
+            y = s.initial_y() if y0 is None else np.array(y0, float)
+            base_in = (s.frames0.copy() if base is None else base)
+            info = s.forces(y, base_in)
+            t = t0
+            h = self.h0
+            self._record(traj, t, y, info, sched(t))
+            next_save = t + self.save_dt
         base = info.frames
-        t = t0
-        h = self.h0
-        self._record(traj, t, y, info, sched(t))
-        next_save = t + self.save_dt
+        ck_steps, ck_secs = self.checkpoint_every_steps, self.checkpoint_every_seconds
+        ck_on = self.checkpoint_path is not None and (ck_steps > 0 or ck_secs > 0)
         bar = None
         if progress:
             from tqdm.auto import tqdm
@@ -130,6 +209,7 @@ class Simulation:
             bar = tqdm(total=round((t_end - t0) / TWO_PI, 3), unit="turn", desc=self.config.name,
                        bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} turns [{elapsed}<{remaining}]")
         start = _time.perf_counter()
+        last_ck = start
         fixed = not self.integrator.adaptive
         eps = 1e-12 * max(1.0, t_end)
         try:
@@ -143,20 +223,25 @@ class Simulation:
                 if not res.accepted:
                     traj.n_rejected += 1
                     if fixed:
-                        raise _Stop(f"t/T={t / TWO_PI:.6g}: {res.reason} with fixed dt={h_try / TWO_PI:.3g} T")
+                        raise _Stop(f"t/T={t / TWO_PI:.6g}: {res.reason} with fixed dt={h_try / TWO_PI:.3g} T"
+                                    f"{self._fastest(y, info)}")
                     h = res.h_next
                     if h < self.h_min:
                         raise _Stop(f"t/T={t / TWO_PI:.6g}: step size {h / TWO_PI:.3g} T fell below "
-                                    f"dt_min={self.h_min / TWO_PI:.3g} T ({res.reason})")
+                                    f"dt_min={self.h_min / TWO_PI:.3g} T ({res.reason})"
+                                    f"{self._fastest(y, info)}")
                     continue
                 traj.n_steps += 1
                 t_new = t + h_try
+                msg = self._guard(res.info)
+                if msg:
+                    # keep the last good frame (every stored frame passed the guards)
+                    if traj.t[-1] < t - eps:
+                        self._record(traj, t, y, info, omega)
+                    raise _Stop(f"t/T={t_new / TWO_PI:.6g}: {msg}")
+                base_in = base
                 y, info = res.y, res.info
                 base = info.frames
-                msg = self._guard(info)
-                if msg:
-                    self._record(traj, t_new, y, info, omega)
-                    raise _Stop(f"t/T={t_new / TWO_PI:.6g}: {msg}")
                 if not fixed:
                     # do not let a step clipped to an output time shrink the controller's step
                     h = res.h_next if h_try >= h * 0.999 else max(h, res.h_next)
@@ -168,6 +253,13 @@ class Simulation:
                     next_save += self.save_dt
                 if traj.n_steps >= self.max_steps:
                     raise _Stop(f"t/T={t / TWO_PI:.6g}: reached numerics.max_steps={self.max_steps}")
+                if ck_on:
+                    now = _time.perf_counter()
+                    if (ck_steps > 0 and traj.n_steps % ck_steps == 0) or \
+                            (ck_secs > 0 and now - last_ck >= ck_secs):
+                        self._write_checkpoint(traj, t, t_end, y, base_in, h, next_save,
+                                               wall0 + now - start)
+                        last_ck = _time.perf_counter()
             if traj.t[-1] < t - eps:
                 self._record(traj, t, y, info, sched(t - eps))
             traj.status = "completed"
@@ -177,7 +269,7 @@ class Simulation:
         finally:
             if bar is not None:
                 bar.close()
-            traj.wall_time = _time.perf_counter() - start
+            traj.wall_time = wall0 + _time.perf_counter() - start
             traj.final_frames = base
         return traj
 
@@ -186,9 +278,13 @@ class _Stop(Exception):
     pass
 
 
-def simulate(config, progress: bool = False, **kwargs) -> Trajectory:
-    """Run ``config`` through its whole motor protocol; see :class:`Simulation`."""
+def simulate(config, progress: bool = False, resume=None, **kwargs) -> Trajectory:
+    """Run ``config`` through its whole motor protocol; see :class:`Simulation`.
+
+    ``resume``: checkpoint to continue from; ``kwargs`` go to :class:`Simulation` (e.g.
+    ``checkpoint_path``, ``checkpoint_every_steps``, ``checkpoint_every_seconds``).
+    """
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=config.numerics.threads):
-        return Simulation(config, **kwargs).run(progress=progress)
+        return Simulation(config, **kwargs).run(progress=progress, resume=resume)

@@ -4,6 +4,17 @@ Examples::
 
     flagwrap run examples/fig4a.toml -o out/fig4a.nc
     flagwrap run --case fig4a -o out/fig4a.nc --figure out/fig4a.png
+    flagwrap run examples/fig4a.toml -o out/fig4a.nc --resume     # after a crash or kill
+
+Checkpoints: the complete loop state goes to ``--checkpoint`` (default ``<output>.ckpt.h5``)
+every ``--checkpoint-seconds`` (default 60) of wall time and/or every ``--checkpoint-every``
+accepted steps, written atomically (temporary file, fsync, rename). ``--resume`` continues from
+it and gives the same run file as an uninterrupted run (bit for bit, same version and threads);
+it refuses a checkpoint of another config or version. The checkpoint is deleted once the run
+completes. A run stopped by a guard (non-finite force, bead in the body, bond strain, step size
+below ``numerics.dt_min``) still writes its run file: every frame up to the last good one, with
+``status = "failed"`` and the message, and exits 1. Input errors exit 2 before any work starts
+(including a run whose output would not fit in memory or on disk).
 """
 
 from __future__ import annotations
@@ -19,6 +30,14 @@ def add_arguments(p):
     p.add_argument("--no-hi", action="store_true", help="switch long-range hydrodynamics off")
     p.add_argument("--integrator", choices=["ros34pw2", "ros2", "euler"], help="override numerics.integrator")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--checkpoint", metavar="PATH", help="checkpoint file (default <output>.ckpt.h5)")
+    p.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
+                   help="also checkpoint every N accepted steps (default: off)")
+    p.add_argument("--checkpoint-seconds", type=float, default=60.0, metavar="S",
+                   help="checkpoint every S seconds of wall time (default 60; 0 = off)")
+    p.add_argument("--no-checkpoint", action="store_true", help="write no checkpoints")
+    p.add_argument("--resume", action="store_true",
+                   help="continue from the checkpoint (same config and options as the first run)")
 
 
 def load(args):
@@ -40,18 +59,43 @@ def load(args):
 
 
 def run(args) -> int:
+    import math
     from pathlib import Path
 
+    from flagwrap.errors import UserInputError
     from flagwrap.io.runfile import write_run
+    from flagwrap.resources import check_disk, check_memory
     from flagwrap.simulation import simulate
 
     cfg = load(args)
     out = Path(args.output or f"out/{cfg.name}.nc")
+    if args.checkpoint_every < 0:
+        raise UserInputError(f"--checkpoint-every must be >= 0, got {args.checkpoint_every}")
+    if not (math.isfinite(args.checkpoint_seconds) and args.checkpoint_seconds >= 0):
+        raise UserInputError(f"--checkpoint-seconds must be >= 0, got {args.checkpoint_seconds}")
+    ckpt = None if args.no_checkpoint else Path(args.checkpoint or f"{out}.ckpt.h5")
+    if args.resume and ckpt is None:
+        raise UserInputError("--resume needs a checkpoint (drop --no-checkpoint)")
+    resume = None
+    if args.resume:
+        from flagwrap.io.checkpoint import check_compatible, read_checkpoint
+
+        resume = read_checkpoint(ckpt)
+        check_compatible(resume, cfg, ckpt)
+    check_memory(cfg)
+    check_disk(cfg, out, checkpoint=ckpt is not None)
+    if resume is not None:
+        print(f"flagwrap run: resuming from {ckpt} at t/T = {resume.t / (2 * math.pi):.4g} "
+              f"({resume.n_steps} steps done)", file=sys.stderr)
     print(f"flagwrap run {cfg.name}: M = {cfg.machin:.4g}, Re = {cfg.reynolds:.3g}, "
           f"omega/omega_c (scaling) = {cfg.omega_ratio_scaling:.3g}, N = {cfg.filament.n_beads}, "
           f"HI {'on' if cfg.numerics.hydrodynamics else 'off'}", file=sys.stderr)
-    traj = simulate(cfg, progress=not args.quiet)
+    traj = simulate(cfg, progress=not args.quiet, resume=resume, checkpoint_path=ckpt,
+                    checkpoint_every_steps=args.checkpoint_every,
+                    checkpoint_every_seconds=args.checkpoint_seconds)
     write_run(traj, out)
+    if traj.ok and ckpt is not None and ckpt.exists():
+        ckpt.unlink()  # the run file now holds everything
     print(f"wrote {out} ({traj.status}, {traj.n_steps} steps, {traj.wall_time:.1f} s)", file=sys.stderr)
     if args.figure:
         from flagwrap.io.runfile import read_run

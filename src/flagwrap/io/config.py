@@ -64,7 +64,7 @@ def _check_types(section: str, cls, table: dict):
 
 def _unit(table: dict, key: str, choices: dict, default: str) -> float:
     name = table.get(key, default)
-    if name not in choices:
+    if not isinstance(name, str) or name not in choices:
         raise UserInputError(f"units.{key} must be one of {', '.join(choices)}, got {name!r}")
     return choices[name]
 

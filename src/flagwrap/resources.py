@@ -1,0 +1,153 @@
+"""What a run will cost in memory and disk, checked before any work starts.
+
+A config can be valid physics and still ask for more than the machine has: a protocol of
+``1e9`` turns saved every ``0.05`` turns, or ``n_beads = 200000`` with dense linear algebra.
+:func:`estimate` prices a :class:`~flagwrap.params.Config`; :func:`check_memory` and
+:func:`check_disk` turn an over-budget estimate into one :class:`UserInputError` naming the
+inputs to change (``motor.protocol`` turns, ``numerics.save_every``, ``filament.n_beads``).
+
+Estimates (bytes, float64):
+
+* recorded output: ``n_saves = total_turns / save_every + 2`` frames of
+  ``8 (3 N + 3 (N-1) + (N-1) + 8)`` bytes (positions, directors, twist angles, scalars); held
+  about three times over while a run file is built (lists, stacked arrays, the SI dataset);
+* dense linear algebra (long-range hydrodynamics, ``ny = 3 N_free + N_bonds + 1 <= 4000``,
+  the crossover of :mod:`flagwrap.integrators.linear`): about five ``ny x ny`` matrices
+  (mobility, Jacobian, their product, ``W``, its LU factors);
+* on disk: the run file (one copy of the output) plus a checkpoint of the same size, each
+  briefly twice while written atomically (temporary file, then rename).
+
+The memory limit is ``FLAGWRAP_MAX_MEMORY`` (bytes, or with a K/M/G/T suffix) if set, else
+half the memory available now (``MemAvailable`` of ``/proc/meminfo``, or ``os.sysconf``).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from flagwrap.errors import UserInputError
+
+#: fraction of the available memory a single run may plan to use
+MEMORY_FRACTION = 0.5
+#: ``ny`` above which the linear solver is matrix-free (integrators/linear.py AUTO_CROSSOVER_NY)
+DENSE_CROSSOVER_NY = 4000
+_SUFFIX = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """Planned cost of one run (bytes)."""
+
+    total_turns: float
+    n_saves: float
+    frame_bytes: int
+    output_memory: float
+    linalg_memory: float
+    file_bytes: float
+
+    @property
+    def memory(self) -> float:
+        return self.output_memory + self.linalg_memory
+
+
+def total_turns(config) -> float:
+    """Duration of the motor protocol in reference turns ``T`` (a phase lasts ``turns / speed``)."""
+    return float(sum(p.turns / (p.speed if p.direction != "stop" else 1.0)
+                     for p in config.motor.protocol))
+
+
+def estimate(config) -> Estimate:
+    fil, num = config.filament, config.numerics
+    N = int(fil.n_beads)
+    turns = total_turns(config)
+    n_saves = turns / num.save_every + 2.0
+    frame = 8 * (3 * N + 3 * (N - 1) + (N - 1) + 8)
+    ny = 4 * N  # 3 (N - 2) + (N - 2) + 1 free coordinates, rounded up
+    dense = num.hydrodynamics and ny <= DENSE_CROSSOVER_NY
+    linalg = 5.0 * 8.0 * ny * ny if dense else 200.0 * 8.0 * ny
+    return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame)
+
+
+def _parse_bytes(text: str) -> float:
+    s = text.strip().upper().removesuffix("B").removesuffix("I")
+    unit = s[-1] if s and s[-1] in "KMGT" else ""
+    try:
+        value = float(s[: len(s) - len(unit)])
+    except ValueError:
+        raise UserInputError(f"FLAGWRAP_MAX_MEMORY must be a size like 8G or 500M, got {text!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise UserInputError(f"FLAGWRAP_MAX_MEMORY must be a positive size, got {text!r}")
+    return value * _SUFFIX[unit]
+
+
+def available_memory() -> float:
+    """Bytes of memory available to a new allocation now (best effort)."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024.0
+    except OSError:
+        pass
+    try:
+        pages = os.sysconf("SC_AVPHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        pages = os.sysconf("SC_PHYS_PAGES")
+    return float(pages) * os.sysconf("SC_PAGE_SIZE")
+
+
+def memory_limit() -> tuple[float, str]:
+    env = os.environ.get("FLAGWRAP_MAX_MEMORY")
+    if env:
+        return _parse_bytes(env), "FLAGWRAP_MAX_MEMORY"
+    return MEMORY_FRACTION * available_memory(), f"{MEMORY_FRACTION:.0%} of the available memory"
+
+
+def _gb(x: float) -> str:
+    return f"{x / 2**30:.3g} GiB"
+
+
+def check_memory(config, limit: float | None = None) -> Estimate:
+    """Raise :class:`UserInputError` if ``config`` would need more memory than ``limit``."""
+    est = estimate(config)
+    why = "given limit"
+    if limit is None:
+        limit, why = memory_limit()
+    if est.memory <= limit:
+        return est
+    num, N = config.numerics, config.filament.n_beads
+    if est.output_memory >= est.linalg_memory:
+        cause = (f"the output: {est.n_saves:.4g} saved frames (motor.protocol turns "
+                 f"{est.total_turns:.4g} / numerics.save_every {num.save_every:g}) of "
+                 f"filament.n_beads={N} beads need {_gb(est.output_memory)}; shorten "
+                 "motor.protocol turns, increase numerics.save_every or reduce filament.n_beads")
+    else:
+        cause = (f"dense linear algebra for filament.n_beads={N} ({4 * N} unknowns) needs "
+                 f"{_gb(est.linalg_memory)}; reduce filament.n_beads or switch "
+                 "numerics.hydrodynamics off")
+    raise UserInputError(f"run would need about {_gb(est.memory)} of memory, more than the limit "
+                         f"{_gb(limit)} ({why}): {cause}")
+
+
+def check_disk(config, output, checkpoint: bool = True, free: float | None = None) -> Estimate:
+    """Raise :class:`UserInputError` if the run file (and checkpoint) would not fit on disk."""
+    est = estimate(config)
+    need = 2.0 * est.file_bytes * (2.0 if checkpoint else 1.0)
+    if free is None:
+        d = Path(output).resolve().parent
+        while not d.exists() and d != d.parent:
+            d = d.parent
+        free = float(shutil.disk_usage(d).free)
+    if need > free:
+        num = config.numerics
+        raise UserInputError(
+            f"run file{' and checkpoint' if checkpoint else ''} for {output} would need about "
+            f"{_gb(need)} of disk, more than the {_gb(free)} free: {est.n_saves:.4g} frames "
+            f"(motor.protocol turns {est.total_turns:.4g} / numerics.save_every "
+            f"{num.save_every:g}) of filament.n_beads={config.filament.n_beads} beads; "
+            "increase numerics.save_every or shorten the protocol")
+    return est

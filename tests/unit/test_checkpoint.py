@@ -1,0 +1,151 @@
+"""Checkpoint and resume: a run killed with SIGKILL and resumed equals the uninterrupted run.
+
+Oracle: the uninterrupted run of the same config in the same environment. The time loop is
+deterministic (numba kernels, single-thread BLAS via ``numerics.threads = 1``) and the
+checkpoint holds its complete state (t, y, the reference frames the forces were computed
+against, the step-size controller's ``h``, the next output time, counters, the frames recorded
+so far), so the comparison is exact: ``np.array_equal``, no tolerance.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from flagwrap.cli.main import main
+from flagwrap.errors import UserInputError
+from flagwrap.io.checkpoint import read_checkpoint
+from flagwrap.io.config import config_from_dict, tomllib
+from flagwrap.io.runfile import read_run
+from flagwrap.simulation import simulate
+
+from conftest import tiny_toml
+
+# ~700 accepted steps (~2-3 s): long enough to be killed mid-way, short enough for CI
+LONG = tiny_toml(ccw=0.2, cw=2.0)
+VARS = ("time", "position", "twist_angle", "director", "motor_angle", "omega", "motor_torque",
+        "elastic_energy", "contact_energy", "min_body_distance", "max_bond_strain")
+
+
+def _assert_same_run(a, b):
+    for v in VARS:
+        assert np.array_equal(a[v].values, b[v].values), v
+    for k in ("status", "n_steps", "n_rejected", "config_toml", "message"):
+        assert a.attrs[k] == b.attrs[k], k
+
+
+def test_kill_9_then_resume_is_bit_identical(tmp_path):
+    cfg = tmp_path / "long.toml"
+    cfg.write_text(LONG)
+    out = tmp_path / "killed.nc"
+    ck = tmp_path / "killed.ckpt.h5"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "flagwrap.cli.main", "run", str(cfg), "-o", str(out), "--quiet",
+         "--checkpoint", str(ck), "--checkpoint-every", "25"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while not ck.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.002)
+    time.sleep(0.05)  # let it run a little past the first checkpoint
+    assert proc.poll() is None, "run finished before it could be killed: " + proc.stderr.read().decode()
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+    assert proc.returncode == -signal.SIGKILL
+    assert not out.exists()  # no run file yet, only the checkpoint
+    state = read_checkpoint(ck)
+    assert 0 < state.n_steps and state.n_steps % 25 == 0
+
+    # resume (same options) and compare with an uninterrupted run
+    rc = main(["run", str(cfg), "-o", str(out), "--quiet", "--checkpoint", str(ck),
+               "--checkpoint-every", "25", "--resume"])
+    assert rc == 0
+    assert not ck.exists()  # removed once the run completed
+    ref = tmp_path / "ref.nc"
+    assert main(["run", str(cfg), "-o", str(ref), "--quiet"]) == 0
+    a, b = read_run(out), read_run(ref)
+    assert state.n_steps < int(b.attrs["n_steps"])  # it really was killed mid-way
+    _assert_same_run(a, b)
+
+
+def test_resume_in_process_from_every_checkpoint_time(tmp_path):
+    """Checkpoints at several step counts (including one inside a rejected-step streak) resume exactly."""
+    cfg = config_from_dict(tomllib.loads(tiny_toml(ccw=0.2, cw=0.5)))
+    ref = simulate(cfg)
+    for every in (1, 7, 50):
+        ck = tmp_path / f"c{every}.h5"
+        simulate(cfg, checkpoint_path=ck, checkpoint_every_steps=every)
+        state = read_checkpoint(ck)
+        again = simulate(cfg, resume=ck)
+        assert again.n_steps == ref.n_steps and again.n_rejected == ref.n_rejected
+        A, B = ref.arrays(), again.arrays()
+        for k in A:
+            assert np.array_equal(A[k], B[k]), (every, k)
+        assert state.n_steps == (ref.n_steps // every) * every
+
+
+def test_checkpoint_by_wall_time(tmp_path):
+    cfg = config_from_dict(tomllib.loads(tiny_toml(ccw=0.1, cw=0.1)))
+    ck = tmp_path / "s.h5"
+    simulate(cfg, checkpoint_path=ck, checkpoint_every_seconds=1e-9)  # every step
+    assert read_checkpoint(ck).n_steps > 0
+
+
+@pytest.fixture
+def checkpoint(tmp_path):
+    cfg = config_from_dict(tomllib.loads(tiny_toml(ccw=0.1, cw=0.1)))
+    ck = tmp_path / "c.h5"
+    simulate(cfg, checkpoint_path=ck, checkpoint_every_steps=5)
+    return cfg, ck
+
+
+def test_resume_refuses_other_config(checkpoint, tmp_path):
+    cfg, ck = checkpoint
+    other = tmp_path / "other.toml"
+    other.write_text(tiny_toml(ccw=0.1, cw=0.1, machin=120))
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "run", str(other), "--quiet",
+                        "--checkpoint", str(ck), "--resume", "-o", str(tmp_path / "o.nc")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert "different config" in r.stderr and "machin" in r.stderr
+
+
+def test_resume_refuses_other_version_and_damaged_files(checkpoint, tmp_path):
+    cfg, ck = checkpoint
+    with h5py.File(ck, "r+") as f:
+        f.attrs["flagwrap_version"] = "0.0.1"
+    with pytest.raises(UserInputError, match="written by flagwrap 0.0.1"):
+        simulate(cfg, resume=ck)
+    with h5py.File(ck, "r+") as f:
+        f.attrs["checkpoint_format"] = 99
+    with pytest.raises(UserInputError, match="checkpoint format 99"):
+        read_checkpoint(ck)
+    data = ck.read_bytes()
+    trunc = tmp_path / "trunc.h5"
+    trunc.write_bytes(data[: len(data) // 2])
+    with pytest.raises(UserInputError, match="not a readable checkpoint"):
+        read_checkpoint(trunc)
+    with pytest.raises(UserInputError, match="no checkpoint"):
+        read_checkpoint(tmp_path / "missing.h5")
+    runfile = tmp_path / "notckpt.h5"
+    with h5py.File(runfile, "w") as f:
+        f.attrs["format"] = "something else"
+    with pytest.raises(UserInputError, match="not a flagwrap checkpoint"):
+        read_checkpoint(runfile)
+    with h5py.File(runfile, "w") as f:
+        f.attrs["format"] = "flagwrap checkpoint"
+        f.attrs["checkpoint_format"] = 1
+    with pytest.raises(UserInputError, match="incomplete or damaged"):
+        read_checkpoint(runfile)
+
+
+def test_resume_without_checkpoint_is_a_clean_error(tmp_path):
+    cfgp = tmp_path / "t.toml"
+    cfgp.write_text(tiny_toml())
+    assert main(["run", str(cfgp), "--quiet", "--resume", "-o", str(tmp_path / "o.nc")]) == 2

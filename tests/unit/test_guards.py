@@ -1,0 +1,130 @@
+"""Guards stop a run with a message naming time, bead and quantity; the partial run file keeps
+every good frame, marked failed; damaged or foreign run files are reported, not misread.
+
+Oracles: a fixed explicit-Euler step far above the stability limit of the stretching springs
+(``h < ~2 M / (k_s mu)``) must blow a bond up within a couple of steps; a guard must never
+let a frame that violates it into the file; the run-file reader's contract (``read_run``).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from flagwrap.errors import UserInputError
+from flagwrap.io.config import config_from_dict, tomllib
+from flagwrap.io.runfile import read_run, write_run
+from flagwrap.resources import check_disk, check_memory, estimate
+from flagwrap.simulation import Simulation, simulate
+
+from conftest import tiny_toml
+
+TINY = tiny_toml(ccw=0.3, cw=0.3)
+
+
+def _cfg(text=TINY, **numerics):
+    d = tomllib.loads(text)
+    d["numerics"].update(numerics)
+    return config_from_dict(d)
+
+
+def test_too_large_euler_step_stops_with_guard_message_and_partial_file(tmp_path):
+    cfgp = tmp_path / "big_dt.toml"
+    cfgp.write_text(TINY + 'integrator = "euler"\ndt = 0.05\n')
+    out = tmp_path / "big_dt.nc"
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "run", str(cfgp), "--quiet",
+                        "-o", str(out)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    msg = re.search(r"run stopped: (.*) \(partial output kept", r.stderr).group(1)
+    # time, bead and quantity
+    pattern = r"t/T=[0-9.]+: bond \d+ \(beads \d+-\d+\) strain [0-9.e+]+ exceeds the limit 0.05"
+    assert re.match(pattern, msg), msg
+    ds = read_run(out)
+    assert ds.attrs["status"] == "failed" and ds.attrs["message"] == msg
+    # every stored frame is a good one (passed the guard), and the file is complete and readable
+    assert len(ds["time"]) >= 2
+    assert np.all(ds["max_bond_strain"].values <= 0.05)
+    assert np.all(np.isfinite(ds["position"].values))
+    t_fail = float(re.match(r"t/T=([0-9.]+)", msg).group(1))
+    assert ds["turns"].values[-1] < t_fail
+
+
+def test_step_size_floor(tmp_path):
+    cfg = _cfg(tol=1e-9, dt=0.02, dt_min=0.01)
+    traj = simulate(cfg)
+    assert traj.status == "failed"
+    assert re.match(r"t/T=0: step size [0-9.e-]+ T fell below dt_min=0.01 T \(error above tolerance\); "
+                    r"fastest bead \d+ \(\|dx/dt\| = ", traj.message), traj.message
+    out = tmp_path / "floor.nc"
+    write_run(traj, out)
+    ds = read_run(out)
+    assert ds.attrs["status"] == "failed" and len(ds["time"]) == 1  # the initial frame
+
+
+def test_non_finite_force_and_body_entry_guards_name_the_bead():
+    cfg = _cfg()
+    sim = Simulation(cfg)
+    s = sim.system
+    y = s.initial_y()
+    info = s.forces(y, s.frames0.copy())
+    assert sim._guard(info) == ""
+    k = 3 * 4 + 1  # free bead 4, y component
+    info.G[k] = np.nan
+    assert sim._guard(info) == f"non-finite generalized force nan on bead {s.nc + 4} (force component y)"
+    info.G[k] = 0.0
+    info.G[s.sl_th.start + 2] = np.inf
+    assert sim._guard(info) == f"non-finite generalized force inf on bond {s.ec + 2} (twist torque)"
+    info.G[s.sl_th.start + 2] = 0.0
+    info.distance[7] = -0.01
+    assert sim._guard(info) == "bead 7 entered the cell body (distance -0.01 L)"
+
+
+def test_truncated_and_foreign_run_files_are_reported(tiny_run, tmp_path):
+    data = tiny_run.read_bytes()
+    for frac in (0.5, 0.9):
+        p = tmp_path / f"cut{frac}.nc"
+        p.write_bytes(data[: int(len(data) * frac)])
+        with pytest.raises(UserInputError, match="truncated"):
+            read_run(p)
+    # the CLI: one line, exit 2
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "analyze", str(tmp_path / "cut0.5.nc")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "truncated" in r.stderr
+    newer = tmp_path / "newer.nc"
+    newer.write_bytes(data)
+    with h5py.File(newer, "r+") as f:
+        f.attrs["format_version"] = 99
+    with pytest.raises(UserInputError, match="format_version 99, newer"):
+        read_run(newer)
+    foreign = tmp_path / "foreign.nc"
+    with h5py.File(foreign, "w") as f:
+        f["x"] = np.arange(3.0)
+    with pytest.raises(UserInputError, match="not a flagwrap run file"):
+        read_run(foreign)
+
+
+def test_resource_guards_name_the_inputs(tmp_path):
+    cfg = _cfg()
+    est = estimate(cfg)
+    assert est.n_saves == pytest.approx(0.6 / 0.05 + 2)
+    check_memory(cfg)
+    long = config_from_dict({**tomllib.loads(TINY), "motor": {
+        "machin": 100, "protocol": [{"direction": "cw", "turns": 1e12}]}})
+    with pytest.raises(UserInputError, match="motor.protocol turns.*numerics.save_every"):
+        check_memory(long)
+    with pytest.raises(UserInputError, match=r"filament.n_beads=1000 \(4000 unknowns\)"):
+        check_memory(_cfg(tiny_toml(n_beads=1000)), limit=100e6)
+    with pytest.raises(UserInputError, match="disk"):
+        check_disk(cfg, tmp_path / "o.nc", free=1000.0)
+    huge = tmp_path / "huge.toml"
+    huge.write_text(TINY.replace("save_every = 0.05", "save_every = 1e-9"))
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "run", str(huge), "--quiet",
+                        "-o", str(tmp_path / "huge.nc")], capture_output=True, text=True,
+                       timeout=120, env={**os.environ, "FLAGWRAP_MAX_MEMORY": "1G"})
+    assert r.returncode == 2 and "numerics.save_every" in r.stderr and "Traceback" not in r.stderr
