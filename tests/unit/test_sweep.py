@@ -251,3 +251,13 @@ def test_real_tiny_case_writes_run_file_and_row(tmp_path):
     ds = read_run(row["run_file"])
     assert ds.attrs.get("status") == "completed"
     assert SweepStore(tmp_path).read_row(row["key"])["key"] == row["key"]
+
+
+def test_verdict_needs_completed_run_for_stable():
+    from flagwrap.sweep.runner import verdict
+
+    assert verdict({"buckled": False, "state": "stable", "run_status": "completed"}) == ("ok", None)
+    assert verdict({"buckled": True, "state": "folding", "run_status": "failed"}) == ("ok", None)
+    st, err = verdict({"buckled": False, "state": "stable", "run_status": "failed", "message": "dt_min"})
+    assert st == "failed" and "dt_min" in err
+    assert verdict({"buckled": None, "state": "failed"})[0] == "failed"

@@ -174,7 +174,15 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
     ax.set_ylabel(r"$M = \eta\omega L^4/A$")
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
     ax.figure.colorbar(sm, ax=ax, label=r"pitch angle $\psi$ [deg]")
-    ax.legend(fontsize=7, loc="lower left")
+    # class symbols in neutral grey in the legend (their colour is psi)
+    from matplotlib.lines import Line2D
+
+    handles, labels = ax.get_legend_handles_labels()
+    proxy = {"stable": Line2D([], [], ls="", marker="o", mfc="none", mec="0.3"),
+             "wrapping": Line2D([], [], ls="", marker="s", mfc="0.3", mec="0.3"),
+             "folding": Line2D([], [], ls="", marker="o", mfc="0.3", mec="0.3")}
+    handles = [proxy.get(lab, h) for h, lab in zip(handles, labels)]
+    ax.legend(handles, labels, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3)
     return ax
 
 
@@ -198,7 +206,7 @@ def fig5(outdir="out/figures", sweep_dirs=None) -> list:
     fit = fit_boundary(brackets)
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    fig, ax = plt.subplots(figsize=(6.8, 5.2))
+    fig, ax = plt.subplots(figsize=(6.8, 6.4))
     diagram(rows, ax=ax, fit=fit, brackets=brackets)
     n_beads = sorted({r.get("n_beads") for r in rows})
     ax.set_title(f"stability diagram, this model ({len(rows)} runs, N = "

@@ -18,7 +18,7 @@ import socket
 import time
 from pathlib import Path
 
-from flagwrap.sweep.runner import RESULT_KEYS, case_row, resolve_runner
+from flagwrap.sweep.runner import RESULT_KEYS, case_row, resolve_runner, verdict
 from flagwrap.sweep.spec import Case
 from flagwrap.sweep.store import SweepStore
 
@@ -57,10 +57,8 @@ def run_geometry(case: Case, root, boundary: dict) -> dict:
         for k in RESULT_KEYS:
             if k in res:
                 row[k] = res[k]
-        ok = res.get("buckled") is not None and res.get("state") != "failed"
-        row.update(status="ok" if ok else "failed",
-                   error=None if ok else f"no buckling verdict: {res.get('message', '')}",
-                   wall_time_s=time.perf_counter() - t1, finished_at=time.time(),
+        status, error = verdict(res)
+        row.update(status=status, error=error, wall_time_s=time.perf_counter() - t1, finished_at=time.time(),
                    host=socket.gethostname(), run_file=str(path) if Path(path).is_file() else None)
         store.write_row(row)
         return res

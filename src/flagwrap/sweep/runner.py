@@ -47,6 +47,20 @@ def resolve_runner(name: str | None):
     return getattr(importlib.import_module(mod), fn)
 
 
+def verdict(res: dict) -> tuple[str, str | None]:
+    """``(status, error)`` of a case function's result: ``"ok"`` only with a buckling verdict.
+
+    As in :class:`flagwrap.analysis.critical.RunCache`: a run that stopped early (a numerical
+    guard tripped) without buckling has no verdict — "stable" would be a guess.
+    """
+    buckled, run_status = res.get("buckled"), str(res.get("run_status", ""))
+    if buckled is None or res.get("state") == "failed":
+        return "failed", f"no buckling verdict: {res.get('message', '')}"
+    if not buckled and run_status not in ("completed", ""):
+        return "failed", f"run {run_status} before a verdict: {res.get('message', '')}"
+    return "ok", None
+
+
 def case_row(case: Case, key: str | None = None) -> dict:
     """The parameter part of a case's row."""
     from flagwrap import __version__
@@ -71,9 +85,7 @@ def run_case(case: Case, root) -> dict:
         for k in RESULT_KEYS:
             if k in res:
                 row[k] = res[k]
-        ok = res.get("buckled") is not None and res.get("state") != "failed"
-        row["status"] = "ok" if ok else "failed"
-        row["error"] = None if ok else f"no buckling verdict: {res.get('message', '')}"
+        row["status"], row["error"] = verdict(res)
     except Exception as exc:  # a failed case is a result, not the end of the sweep
         row.update(status="failed", state="failed", buckled=None,
                    error=f"{type(exc).__name__}: {exc}")

@@ -6,7 +6,8 @@ Layout of ``out/sweeps/<name>/``::
     rows/<key>.json        the case's row: parameters, status, class, t_c, error (atomic rename)
     boundary/<gkey>.json   boundary mode: M_c bracket of one geometry (atomic rename)
     critical/              boundary mode: the analysis.critical run cache of the searches
-    table.parquet|.csv     the table of all rows, rewritten at the end of each sweep
+    table.parquet          the table of all rows, rewritten at the end of each sweep
+                           (without pyarrow: table.nc, netCDF4, and table.csv)
 
 A row is written with ``tempfile`` + ``fsync`` + ``os.replace`` into ``rows/``: after a
 SIGKILL at any instant a row exists complete or not at all, and one file per key makes a
@@ -131,25 +132,49 @@ class SweepStore:
         return df
 
     def export(self) -> Path:
-        """Write the table to ``table.parquet`` if pyarrow is installed, else ``table.csv``
-        (atomic)."""
+        """Write the table to ``table.parquet`` if pyarrow is installed, else to ``table.nc``
+        (netCDF4/HDF5, dimension ``key``) and ``table.csv``; each atomically. Returns the
+        Parquet or netCDF path."""
         df = self.table()
+        self.root.mkdir(parents=True, exist_ok=True)
         try:
             import pyarrow  # noqa: F401
 
-            path, kind = self.root / "table.parquet", "parquet"
+            kinds = ["parquet"]
         except ModuleNotFoundError:
-            path, kind = self.root / "table.csv", "csv"
-        self.root.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.root)
-        os.close(fd)
-        try:
-            if kind == "parquet":
-                df.to_parquet(tmp, index=False)
+            kinds = ["nc", "csv"]
+        for kind in kinds:
+            path = self.root / f"table.{kind}"
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.root)
+            os.close(fd)
+            try:
+                if kind == "parquet":
+                    df.to_parquet(tmp, index=False)
+                elif kind == "csv":
+                    df.to_csv(tmp, index=False)
+                else:
+                    _to_netcdf(df, tmp)
+                os.replace(tmp, path)
+            finally:
+                if os.path.exists(tmp):
+                    os.unlink(tmp)
+        return self.root / f"table.{kinds[0]}"
+
+
+def _to_netcdf(df, path):
+    """Rows -> netCDF: dimension ``key``; object columns of bools/None become float 1/0/nan,
+    other object columns strings ("" for None)."""
+    import numpy as np
+    import xarray as xr
+
+    d = df.copy()
+    for c in d.columns:
+        if d[c].dtype == object:
+            vals = [v for v in d[c] if v is not None and not (isinstance(v, float) and math.isnan(v))]
+            if vals and all(isinstance(v, bool) for v in vals):
+                d[c] = [np.nan if v is None else float(v) for v in d[c]]
             else:
-                df.to_csv(tmp, index=False)
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-        return path
+                d[c] = ["" if v is None else str(v) for v in d[c]]
+    if "key" in d.columns:
+        d = d.set_index("key")
+    xr.Dataset.from_dataframe(d).to_netcdf(path, engine="h5netcdf")
