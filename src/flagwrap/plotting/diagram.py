@@ -11,7 +11,6 @@ bacteria of the SI (``flagwrap.bacteria``).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 

@@ -182,8 +182,6 @@ class Case:
 
     def config_dict(self) -> dict:
         """The full SI config (nested dict for :func:`flagwrap.io.config.config_from_dict`)."""
-        from flagwrap.params import Phase  # noqa: F401  (documents the protocol format)
-
         d = _merge(BASE_CONFIG, self.base)
         fil = d["filament"]
         L = float(fil.get("length", LENGTH))
