@@ -13,6 +13,7 @@ smoothed rise >= 0.15 L held 1 turn), wall time.
 
 Runs are written to ``out/sensitivity/<variant>_M<M>.nc`` and skipped if the file exists,
 so the study can be interrupted and resumed. Runs are sequential (one core).
+N = 121 at M = 600 (in the plan) did not finish in 16 min on a loaded core and has no result yet.
 """
 
 from __future__ import annotations
