@@ -199,6 +199,13 @@ class RodSystem:
         d = self.local_mobility_diagonal()
         return sp.block_diag((Mx, sp.diags(d[3 * self.nb:])), format="csr")
 
+    def mobility_blocks(self, y: np.ndarray):
+        """``Mob`` as its two non-zero blocks: dense translational (3nb, 3nb), twist diagonal (ne,)."""
+        x, _, _ = self.unpack(y)
+        Mxx = self.mobility.matrix(x[self.nc:])
+        Mxx /= self.machin
+        return Mxx, 1.0 / (self.machin * self.rot_drag[self.ec:])
+
     def mobility_matrix(self, y: np.ndarray) -> np.ndarray:
         """Dense ``Mob(y)`` (ny, ny)."""
         x, _, _ = self.unpack(y)
