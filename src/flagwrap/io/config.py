@@ -43,6 +43,11 @@ _LENGTH_KEYS = {
 }
 
 
+def _show(key) -> str:
+    """A key as it can be printed on one line: plain names as they are, anything else repr'd."""
+    return key if isinstance(key, str) and key.isidentifier() else repr(key)
+
+
 def _fields(cls):
     return {f.name: f for f in dataclasses.fields(cls)}
 
@@ -54,7 +59,7 @@ def _check_types(section: str, cls, table: dict):
     for key, value in table.items():
         if key not in known:
             raise UserInputError(
-                f"unknown key {section}.{key}; allowed: {', '.join(sorted(known))}"
+                f"unknown key {section}.{_show(key)}; allowed: {', '.join(sorted(known))}"
             )
         if isinstance(value, (dict, list)) and not (section == "motor" and key == "protocol"):
             raise UserInputError(f"{section}.{key} must be a single value, got {type(value).__name__}")
@@ -82,7 +87,8 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
         raise UserInputError("[units] must be a table")
     for key in u:
         if key not in ("length", "pressure", "viscosity", "density"):
-            raise UserInputError(f"unknown key units.{key}; allowed: density, length, pressure, viscosity")
+            raise UserInputError(
+                f"unknown key units.{_show(key)}; allowed: density, length, pressure, viscosity")
     lf = _unit(u, "length", _LENGTH, "m")
     pf = _unit(u, "pressure", _PRESSURE, "Pa")
     vf = _unit(u, "viscosity", _VISCOSITY, "Pa s")
