@@ -51,6 +51,7 @@ import math
 from pathlib import Path
 
 from flagwrap.errors import UserInputError
+from flagwrap.io.atomic import atomic_write
 
 
 @dataclasses.dataclass(frozen=True)
@@ -238,9 +239,8 @@ class RunCache:
             self.n_simulated += 1
             res = {k: (None if isinstance(v, float) and math.isnan(v) else v)
                    for k, v in res.items() if isinstance(v, (bool, int, float, str, type(None)))}
-            tmp = js.with_suffix(".json.tmp")
-            tmp.write_text(json.dumps(res, sort_keys=True, indent=1))
-            tmp.replace(js)
+            text = json.dumps(res, sort_keys=True, indent=1)
+            atomic_write(js, lambda tmp: tmp.write_text(text))
 
         def num(k):
             v = res.get(k)

@@ -25,8 +25,6 @@ written to a temporary name in the same folder, fsynced and renamed, so a crash 
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,6 +32,7 @@ import numpy as np
 
 from flagwrap import __version__
 from flagwrap.errors import UserInputError
+from flagwrap.io.atomic import atomic_write
 
 CHECKPOINT_FORMAT = 1
 _MAGIC = "flagwrap checkpoint"
@@ -68,28 +67,11 @@ class Checkpoint:
         return Frames(self.base_t.copy(), self.base_d1.copy(), self.base_rt.copy())
 
 
-def _fsync_dir(path: Path):
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:  # pragma: no cover - platforms without directory fds
-        return
-    try:
-        os.fsync(fd)
-    except OSError:  # pragma: no cover
-        pass
-    finally:
-        os.close(fd)
-
-
 def write_checkpoint(ckpt: Checkpoint, path) -> Path:
     """Write ``ckpt`` to ``path`` atomically (temporary file, fsync, rename, fsync folder)."""
     import h5py
 
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
+    def write(tmp):
         with h5py.File(tmp, "w") as f:
             f.attrs["format"] = _MAGIC
             f.attrs["checkpoint_format"] = CHECKPOINT_FORMAT
@@ -102,14 +84,8 @@ def write_checkpoint(ckpt: Checkpoint, path) -> Path:
             g = f.create_group("records")
             for k in RECORD_NAMES:
                 g.create_dataset(k, data=np.asarray(ckpt.records[k], dtype=np.float64))
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-        _fsync_dir(path.parent)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+
+    return atomic_write(path, write, sync_dir=True)
 
 
 def read_checkpoint(path) -> Checkpoint:

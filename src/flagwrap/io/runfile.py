@@ -30,8 +30,6 @@ half-written file under the final name.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -107,20 +105,10 @@ def trajectory_dataset(traj):
 
 
 def write_dataset_atomic(ds, path) -> Path:
-    """Write an xarray dataset to ``path`` via a temporary file, fsync and rename."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        ds.to_netcdf(tmp, engine="h5netcdf")
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    """Write an xarray dataset to ``path`` atomically (see :mod:`flagwrap.io.atomic`)."""
+    from flagwrap.io.atomic import atomic_write
+
+    return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
 
 
 def write_run(traj, path) -> Path:

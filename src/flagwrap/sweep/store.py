@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
+
+from flagwrap.io.atomic import atomic_write
 
 #: columns that differ between two runs of the same case (timing, host); excluded from
 #: :meth:`SweepStore.table` with ``volatile=False``
@@ -29,20 +29,9 @@ VOLATILE = ("wall_time_s", "finished_at", "host", "run_file")
 
 
 def write_json_atomic(obj, path) -> Path:
-    """Write ``obj`` as JSON to ``path`` via a temporary file in the same folder, fsync, rename."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(obj, fh, sort_keys=True, indent=1, allow_nan=False)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    """Write ``obj`` as JSON to ``path`` atomically (see :mod:`flagwrap.io.atomic`)."""
+    text = json.dumps(obj, sort_keys=True, indent=1, allow_nan=False)
+    return atomic_write(path, lambda tmp: tmp.write_text(text))
 
 
 def jsonable(obj):
@@ -145,19 +134,12 @@ class SweepStore:
             kinds = ["nc", "csv"]
         for kind in kinds:
             path = self.root / f"table.{kind}"
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.root)
-            os.close(fd)
-            try:
-                if kind == "parquet":
-                    df.to_parquet(tmp, index=False)
-                elif kind == "csv":
-                    df.to_csv(tmp, index=False)
-                else:
-                    _to_netcdf(df, tmp)
-                os.replace(tmp, path)
-            finally:
-                if os.path.exists(tmp):
-                    os.unlink(tmp)
+            if kind == "parquet":
+                atomic_write(path, lambda tmp: df.to_parquet(tmp, index=False))
+            elif kind == "csv":
+                atomic_write(path, lambda tmp: df.to_csv(tmp, index=False))
+            else:
+                atomic_write(path, lambda tmp: _to_netcdf(df, tmp))
         return self.root / f"table.{kinds[0]}"
 
 
