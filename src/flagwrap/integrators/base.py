@@ -34,6 +34,30 @@ class Integrator:
         raise NotImplementedError
 
 
+class AdaptiveMixin:
+    """Step-size control shared by the embedded-pair schemes.
+
+    ``h_next = h min(grow, max(shrink, safety err^(-1/k)))`` with ``k`` = order of the error
+    estimate + 1; a step is rejected when the scaled error exceeds 1 or anything is non-finite.
+    """
+
+    safety: float
+    grow: float
+    shrink: float
+
+    def reject(self, h, reason) -> StepResult:
+        return StepResult(False, None, None, h * self.shrink, np.inf, reason)
+
+    def conclude(self, system, base, y_new, err, h, estimate_order) -> StepResult:
+        if not np.isfinite(err) or not np.all(np.isfinite(y_new)):
+            return self.reject(h, "non-finite state")
+        fac = self.safety * (1.0 / max(err, 1e-10)) ** (1.0 / (estimate_order + 1))
+        h_next = h * min(self.grow, max(self.shrink, fac))
+        if err > 1.0:
+            return StepResult(False, None, None, h_next, err, "error above tolerance")
+        return StepResult(True, y_new, system.forces(y_new, base), h_next, err)
+
+
 def scaled_error(system, err: np.ndarray, tol: float) -> float:
     """Max-norm of the local error: positions against ``tol`` [L], twist angles against ``10 tol``."""
     ex = np.abs(err[system.sl_x]).max() / tol if system.nb else 0.0

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from flagwrap.integrators.base import Integrator, StepResult, scaled_error
+from flagwrap.integrators.base import AdaptiveMixin, Integrator, StepResult, scaled_error
 from flagwrap.integrators.linear import SingularW, make_w
 
 GAMMA = 4.3586652150845900e-01
@@ -43,7 +43,7 @@ M_T = _B @ _GINV
 E_T = (_B - _BHAT) @ _GINV
 
 
-class ROS34PW2(Integrator):
+class ROS34PW2(AdaptiveMixin, Integrator):
     order = 3
     adaptive = True
     name = "ros34pw2"
@@ -61,7 +61,7 @@ class ROS34PW2(Integrator):
         try:
             W = make_w(self.linear_solver, system, y, base, info.G, GAMMA * h)
         except SingularW as exc:
-            return StepResult(False, None, None, h * self.shrink, np.inf, f"singular W ({exc})")
+            return self.reject(h, f"singular W ({exc})")
         s = 4
         U = np.empty((s, system.ny))
         for i in range(s):
@@ -71,24 +71,16 @@ class ROS34PW2(Integrator):
             else:
                 Yi = y + A_T[i, :i] @ U[:i]
                 if not np.all(np.isfinite(Yi)):
-                    return StepResult(False, None, None, h * self.shrink, np.inf, "non-finite stage")
+                    return self.reject(h, "non-finite stage")
                 f, _ = system.rhs(Yi, base, omega)
             rhs = f + (C_T[i, :i] @ U[:i]) / h if i else f
             try:
                 U[i] = W.solve((GAMMA * h) * rhs)
             except SingularW as exc:
-                return StepResult(False, None, None, h * self.shrink, np.inf, str(exc))
+                return self.reject(h, str(exc))
         y_new = y + M_T @ U
         err_vec = E_T @ U
         if self.filter_error:
             err_vec = W.solve(err_vec)
         err = scaled_error(system, err_vec, self.tol)
-        if not np.isfinite(err) or not np.all(np.isfinite(y_new)):
-            return StepResult(False, None, None, h * self.shrink, np.inf, "non-finite state")
-        # embedded method has order 2: local error estimate O(h^3)
-        fac = self.safety * (1.0 / max(err, 1e-10)) ** (1.0 / 3.0)
-        h_next = h * min(self.grow, max(self.shrink, fac))
-        if err > 1.0:
-            return StepResult(False, None, None, h_next, err, "error above tolerance")
-        info_new = system.forces(y_new, base)
-        return StepResult(True, y_new, info_new, h_next, err)
+        return self.conclude(system, base, y_new, err, h, estimate_order=2)

@@ -20,13 +20,13 @@ import math
 
 import numpy as np
 
-from flagwrap.integrators.base import Integrator, StepResult, scaled_error
+from flagwrap.integrators.base import AdaptiveMixin, Integrator, StepResult, scaled_error
 from flagwrap.integrators.linear import SingularW, make_w
 
 GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
 
 
-class ROS2(Integrator):
+class ROS2(AdaptiveMixin, Integrator):
     order = 2
     adaptive = True
     name = "rosenbrock"
@@ -48,15 +48,15 @@ class ROS2(Integrator):
             W = make_w(self.linear_solver, system, y, base, G0, GAMMA * h)
             k1 = W.solve(f0)
         except SingularW as exc:
-            return StepResult(False, None, None, h * self.shrink, np.inf, f"singular W ({exc})")
+            return self.reject(h, f"singular W ({exc})")
         y1 = y + h * k1
         if not np.all(np.isfinite(y1)):
-            return StepResult(False, None, None, h * self.shrink, np.inf, "non-finite stage")
+            return self.reject(h, "non-finite stage")
         f1, _ = system.rhs(y1, base, omega)
         try:
             k2 = W.solve(f1 - 2.0 * k1)
         except SingularW as exc:
-            return StepResult(False, None, None, h * self.shrink, np.inf, str(exc))
+            return self.reject(h, str(exc))
         y_new = y + h * (1.5 * k1 + 0.5 * k2)
         # Shampine's filter: W^-1 applied to the raw estimate removes the spurious error of
         # the stiff (instantly relaxing) components, which would otherwise cap the step.
@@ -64,11 +64,4 @@ class ROS2(Integrator):
         if self.filter_error:
             err_vec = W.solve(err_vec)
         err = scaled_error(system, err_vec, self.tol)
-        if not np.isfinite(err) or not np.all(np.isfinite(y_new)):
-            return StepResult(False, None, None, h * self.shrink, np.inf, "non-finite state")
-        fac = self.safety * (1.0 / max(err, 1e-10)) ** 0.5
-        h_next = h * min(self.grow, max(self.shrink, fac))
-        if err > 1.0:
-            return StepResult(False, None, None, h_next, err, "error above tolerance")
-        info_new = system.forces(y_new, base)
-        return StepResult(True, y_new, info_new, h_next, err)
+        return self.conclude(system, base, y_new, err, h, estimate_order=1)
