@@ -124,7 +124,7 @@ def read_run(path):
     if not path.is_file():
         raise UserInputError(f"run file not found: {path}")
     try:
-        ds = xr.load_dataset(path, engine="h5netcdf")
+        ds = xr.load_dataset(path, engine="h5netcdf", phony_dims="sort")
     except Exception as exc:  # truncated / not HDF5
         raise UserInputError(f"{path} is not a readable run file (truncated or not netCDF4): {exc}") from None
     fv = ds.attrs.get("format_version")
