@@ -105,9 +105,14 @@ class SparseW:
 
         if system.mobility.long_range:
             raise ValueError("SparseW needs a local mobility (numerics.hydrodynamics = false)")
-        J = system.force_jacobian_sparse(y, base, G0)
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0)
         d = system.local_mobility_diagonal()
-        W = sp.identity(system.ny, format="csc") - gamma_h * (sp.diags(d) @ J).tocsc()
+        n = system.ny
+        # W = I - gamma h diag(d) J assembled straight from the triplets (duplicates add)
+        diag = np.arange(n)
+        W = sp.csc_matrix((np.concatenate([-gamma_h * d[rows] * vals, np.ones(n)]),
+                           (np.concatenate([rows, diag]), np.concatenate([cols, diag]))),
+                          shape=(n, n))
         try:
             self.lu = spla.splu(W)
         except RuntimeError as exc:
