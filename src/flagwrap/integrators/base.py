@@ -41,9 +41,18 @@ class AdaptiveMixin:
     estimate + 1; a step is rejected when the scaled error exceeds 1 or anything is non-finite.
     """
 
-    safety: float
-    grow: float
-    shrink: float
+    default_tol: float = 1e-4
+    default_filter: bool = False
+
+    def __init__(self, tol: float | None = None, safety: float = 0.9, grow: float = 4.0,
+                 shrink: float = 0.2, filter_error: bool | None = None,
+                 linear_solver: str = "auto"):
+        self.tol = self.default_tol if tol is None else tol
+        self.safety = safety
+        self.grow = grow
+        self.shrink = shrink
+        self.filter_error = self.default_filter if filter_error is None else filter_error
+        self.linear_solver = linear_solver
 
     def reject(self, h, reason) -> StepResult:
         return StepResult(False, None, None, h * self.shrink, np.inf, reason)

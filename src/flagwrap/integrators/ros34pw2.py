@@ -48,14 +48,8 @@ class ROS34PW2(AdaptiveMixin, Integrator):
     adaptive = True
     name = "ros34pw2"
 
-    def __init__(self, tol: float = 1e-4, safety: float = 0.9, grow: float = 4.0,
-                 shrink: float = 0.2, filter_error: bool = False, linear_solver: str = "auto"):
-        self.tol = tol
-        self.linear_solver = linear_solver
-        self.safety = safety
-        self.grow = grow
-        self.shrink = shrink
-        self.filter_error = filter_error
+    default_tol = 1e-4
+    default_filter = False  # see the error-estimate comment in step()
 
     def step(self, system, y, base, info, h, omega) -> StepResult:
         try:

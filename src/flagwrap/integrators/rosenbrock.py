@@ -31,14 +31,8 @@ class ROS2(AdaptiveMixin, Integrator):
     adaptive = True
     name = "rosenbrock"
 
-    def __init__(self, tol: float = 1e-3, safety: float = 0.9, grow: float = 4.0, shrink: float = 0.2,
-                 filter_error: bool = True, linear_solver: str = "auto"):
-        self.tol = tol
-        self.linear_solver = linear_solver
-        self.filter_error = filter_error
-        self.safety = safety
-        self.grow = grow
-        self.shrink = shrink
+    default_tol = 1e-3
+    default_filter = True  # see the error-estimate comment in step()
 
     def step(self, system, y, base, info, h, omega) -> StepResult:
         G0 = info.G
