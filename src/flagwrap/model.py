@@ -86,7 +86,10 @@ class RodSystem:
         self.sl_th = slice(3 * self.nb, 3 * self.nb + self.ne)
         # hydrodynamics (radius in core units)
         self.radius = fil.bead_radius / L
-        self.mobility = mobility or make_mobility(config.numerics.hydrodynamics, self.radius)
+        num = config.numerics
+        self.mobility = mobility or make_mobility(
+            num.hydrodynamics, self.radius, backend=num.mobility_backend,
+            n=config.filament.n_beads, threads=num.threads, fmm_eps=num.mobility_tol)
         w = np.ones(N - 1)
         w[0] += 0.5
         w[-1] += 0.5

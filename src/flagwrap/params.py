@@ -367,8 +367,21 @@ class Numerics:
         within ~0.5 % of a converged solution over a turn; loose tolerances are visibly wrong
         (ros2 at 1e-3 triggers a spurious CCW instability; see docs/numerics.md).
     threads : int
-        BLAS threads for the dense linear algebra of one run (1 is fastest at N ~ 60 and lets
-        sweeps run one case per core).
+        BLAS threads for the dense linear algebra of one run, and numba threads of the direct
+        RPY product above 256 beads (1 is fastest at N ~ 60 and lets sweeps run one case per
+        core).
+    mobility_backend : {"auto", "direct", "fmm", "jax"}
+        how the RPY product ``Mob F`` is computed (:mod:`flagwrap.hydrodynamics.mobility`):
+        "direct" numba O(N^2) sum, "fmm" FMM3D (needs ``fmm3dpy``), "jax" JAX direct sum
+        (needs ``jax``; GPU when present). "auto": direct, or jax when jax sees a GPU and
+        N >= 2000. All agree to 1e-10 (fmm: to ``mobility_tol``).
+    mobility_tol : float
+        requested relative precision of the FMM backend.
+    linear_solver : {"auto", "dense", "near", "krylov", "sparse"}
+        solver of the Rosenbrock stage equations (:mod:`flagwrap.integrators.linear`): exact
+        dense LU, sparse LU of the near-field ``W`` (a W-method approximation, O(N)), GMRES,
+        or exact sparse LU (HI off only). "auto": sparse with HI off; dense up to
+        ``AUTO_CROSSOVER_NY`` unknowns, near above.
     dt_min : float
         smallest step [turns] before the run is declared stuck.
     save_every : float
@@ -385,8 +398,32 @@ class Numerics:
     save_every: float = 0.05
     max_steps: int = 50_000_000
     threads: int = 1
+    mobility_backend: str = "auto"
+    mobility_tol: float = 1e-10
+    linear_solver: str = "auto"
+
+    # performance options left out of result keys at their defaults (Config.to_dict(for_hash))
+    HASH_OMIT_DEFAULTS = {"mobility_backend": "auto", "mobility_tol": 1e-10, "linear_solver": "auto"}
 
     def __post_init__(self):
+        from flagwrap.hydrodynamics.mobility import BACKENDS, backend_missing
+
+        if self.mobility_backend not in BACKENDS:
+            raise UserInputError(f"numerics.mobility_backend must be one of {', '.join(BACKENDS)}, "
+                                 f"got {self.mobility_backend!r}")
+        why = backend_missing(self.mobility_backend)
+        if why:
+            raise UserInputError(f"numerics.mobility_backend = {self.mobility_backend!r} {why}")
+        tol_m = _positive("numerics.mobility_tol", self.mobility_tol)
+        if tol_m > 1e-2:
+            raise UserInputError(f"numerics.mobility_tol must be in (0, 1e-2], got {tol_m}")
+        solvers = ("auto", "dense", "near", "krylov", "sparse")
+        if self.linear_solver not in solvers:
+            raise UserInputError(f"numerics.linear_solver must be one of {', '.join(solvers)}, "
+                                 f"got {self.linear_solver!r}")
+        if self.linear_solver == "sparse" and self.hydrodynamics:
+            raise UserInputError("numerics.linear_solver = 'sparse' needs numerics.hydrodynamics = "
+                                 "false (it is exact only for a local mobility); use 'auto'")
         if self.integrator not in ("ros34pw2", "ros2", "euler"):
             raise UserInputError(
                 "numerics.integrator must be 'ros34pw2', 'ros2' or 'euler', "
@@ -506,8 +543,13 @@ class Config:
     def replace(self, **changes) -> "Config":
         return dataclasses.replace(self, **changes)
 
-    def to_dict(self) -> dict:
-        """Plain nested dict (JSON/TOML-able); ``None`` values are dropped."""
+    def to_dict(self, for_hash: bool = False) -> dict:
+        """Plain nested dict (JSON/TOML-able); ``None`` values are dropped.
+
+        ``for_hash``: also drop the numerics options added after results were first stored
+        (``Numerics.HASH_OMIT_DEFAULTS``) when they hold their defaults, so run/sweep keys
+        of existing results stay valid when a new option appears.
+        """
 
         def clean(obj):
             if dataclasses.is_dataclass(obj):
@@ -522,4 +564,8 @@ class Config:
         # pitch-like inputs are all stored after resolution; keep only pitch (canonical)
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)
+        if for_hash:
+            for k, v in Numerics.HASH_OMIT_DEFAULTS.items():
+                if d["numerics"].get(k) == v:
+                    d["numerics"].pop(k)
         return d

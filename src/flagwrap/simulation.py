@@ -86,7 +86,7 @@ class Simulation:
         self._config_toml = None
         self.system = system or RodSystem(config)
         num = config.numerics
-        self.integrator = integrator or make_integrator(num.integrator, num.tol)
+        self.integrator = integrator or make_integrator(num.integrator, num.tol, num.linear_solver)
         self.h0 = num.dt * TWO_PI
         self.h_min = num.dt_min * TWO_PI
         self.save_dt = num.save_every * TWO_PI

@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -53,3 +54,73 @@ def test_local_mobility_is_self_term_only():
     x = np.random.default_rng(0).standard_normal((5, 3))
     F = np.ones((5, 3))
     np.testing.assert_allclose(LocalMobility(0.5).apply(x, F), F / (6 * math.pi * 0.5))
+
+
+def _chain(n, seed=3):
+    """A helical bead chain with overlapping neighbours (b = 1.6 a) and a few random kicks."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 6 * 2 * math.pi, n)
+    x = np.stack([np.cos(t), np.sin(t), 0.15 * t], axis=1)
+    a = np.linalg.norm(x[1] - x[0]) / 1.6
+    x += 0.05 * a * rng.standard_normal(x.shape)
+    return x, a, rng.standard_normal((n, 3))
+
+
+def test_threaded_direct_product_is_identical():
+    from flagwrap.hydrodynamics.mobility import RPYMobility
+
+    x, a, F = _chain(700)
+    # each row is summed in the same order, so threads change nothing, bit for bit
+    np.testing.assert_array_equal(RPYMobility(a, threads=2).apply(x, F), RPYMobility(a).apply(x, F))
+
+
+@pytest.mark.parametrize("eps", [1e-4, 1e-8, 1e-12])
+def test_fmm_backend_meets_its_requested_precision(eps):
+    pytest.importorskip("fmm3dpy")
+    from flagwrap.hydrodynamics.mobility import FMMMobility
+
+    x, a, F = _chain(1500)
+    ref = (RPYMobility(a).matrix(x) @ F.ravel()).reshape(-1, 3)
+    got = FMMMobility(a, eps=eps).apply(x, F)
+    err = np.linalg.norm(got - ref) / np.linalg.norm(ref)
+    # FMM3D's eps bounds the relative l2 error of each kernel sum; 1e-10 floor = round-off of
+    # the overlap corrections; 10x margin for the sum of the two FMMs
+    assert err <= max(10 * eps, 1e-10), err
+
+
+def test_jax_backend_agrees_with_dense():
+    pytest.importorskip("jax")
+    from flagwrap.hydrodynamics.mobility import JAXMobility
+
+    for n, block in ((1, 4), (37, 8), (300, 128)):
+        x, a, F = _chain(max(n, 2))
+        x, F = x[:n], F[:n]
+        ref = (RPYMobility(a).matrix(x) @ F.ravel()).reshape(-1, 3)
+        got = JAXMobility(a, block=block).apply(x, F)
+        np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-10 * np.abs(ref).max())
+
+
+def test_gpu_backend_agrees_with_dense_when_a_gpu_is_present():
+    from flagwrap.hydrodynamics.mobility import JAXMobility, jax_gpu_available
+
+    if not jax_gpu_available():
+        pytest.skip("no GPU visible to jax: the GPU backend is not used here")
+    x, a, F = _chain(4000)
+    ref = RPYMobility(a).apply(x, F)
+    got = JAXMobility(a).apply(x, F)
+    np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-10 * np.abs(ref).max())
+
+
+def test_auto_backend_is_direct_without_gpu_and_names_missing_packages():
+    from flagwrap.hydrodynamics import mobility as mob
+
+    if not mob.jax_gpu_available():
+        assert mob.make_mobility(True, 0.1, "auto", n=10**5).backend == "direct"
+    assert mob.make_mobility(True, 0.1, "auto", n=10).backend == "direct"
+    assert isinstance(mob.make_mobility(False, 0.1, "fmm"), LocalMobility)
+    assert mob.backend_missing("direct") is None
+    for name in ("fmm", "jax"):
+        why = mob.backend_missing(name)
+        assert why is None or "pip install" in why
+    with pytest.raises(ValueError, match="mobility backend"):
+        mob.make_mobility(True, 0.1, "gpu")

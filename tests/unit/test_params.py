@@ -83,3 +83,27 @@ def test_nonlocal_distance_of_a_tight_helix_is_the_pitch():
     d = min_nonlocal_distance(fil, Clamp(lead="kink"))
     assert d == pytest.approx(0.0032, rel=0.02)
     Config(filament=fil, motor=Motor(machin=10))  # P > 2a: accepted
+
+
+@pytest.mark.parametrize("kw, match", [
+    ({"mobility_backend": "gpu"}, "mobility_backend"),
+    ({"mobility_tol": 0.5}, "mobility_tol"),
+    ({"linear_solver": "lu"}, "linear_solver"),
+    ({"linear_solver": "sparse"}, "hydrodynamics"),
+])
+def test_numerics_backend_choices_are_checked(kw, match):
+    from flagwrap.params import Numerics
+
+    with pytest.raises(UserInputError, match=match):
+        Numerics(**kw)
+
+
+def test_numerics_backend_missing_package_is_named(monkeypatch):
+    import importlib.util
+
+    from flagwrap.params import Numerics
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "fmm3dpy" else real(name, *a))
+    with pytest.raises(UserInputError, match="pip install fmm3dpy"):
+        Numerics(mobility_backend="fmm")

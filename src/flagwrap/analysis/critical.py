@@ -116,7 +116,7 @@ def config_key(cfg) -> str:
     from flagwrap import __version__
     from flagwrap.io.config import config_to_toml
 
-    text = config_to_toml(cfg.replace(name="run")) + f"\n# flagwrap {__version__}\n"
+    text = config_to_toml(cfg.replace(name="run"), for_hash=True) + f"\n# flagwrap {__version__}\n"
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 

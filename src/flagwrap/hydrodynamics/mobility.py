@@ -7,8 +7,21 @@ A mobility maps forces on the hydrodynamically active beads to their velocities,
 * ``apply(x, F) -> V``     matrix-free product, (n,3) -> (n,3)
 * ``matrix(x) -> (3n,3n)`` dense matrix (for direct linear solves at small n)
 
-``make_mobility(hydrodynamics, radius)`` picks the backend. Faster (FMM, GPU) backends plug in
-here without touching the integrators.
+``make_mobility(hydrodynamics, radius, backend=...)`` picks the backend
+(``numerics.mobility_backend``):
+
+* ``"direct"``: numba O(n^2) product, vectorised (AVX2), O(n) memory, optionally threaded;
+* ``"fmm"``: FMM3D (``pip install fmm3dpy``): Stokes FMM + Laplace dipole FMM, O(n) per
+  product, plus exact overlap corrections (Liang, Gimbutas, Greengard, Huang & Jiang,
+  J. Chem. Phys. 139, 134105 (2013), Eqs. 8-10);
+* ``"jax"``: the direct sum in JAX (``pip install jax``; on a GPU when jax sees one);
+* ``"auto"`` (default): ``direct``, except on a machine where jax sees a GPU and
+  ``n >= GPU_AUTO_MIN_BEADS``. FMM is never chosen automatically: on this project's 2-core
+  CPU it was slower than the vectorised direct sum at every N up to 16000
+  (benchmarks/scaling.py prints both).
+
+The integrators only see ``apply``/``matrix``/``near_field``, so a backend swaps without
+touching them.
 """
 
 from __future__ import annotations
@@ -44,19 +57,21 @@ class Mobility:
 
 
 class RPYMobility(Mobility):
-    """Full Rotne-Prager-Yamakawa mobility (paper, Methods), numba O(n^2)."""
+    """Full Rotne-Prager-Yamakawa mobility (paper, Methods), numba O(n^2) direct sum."""
 
     long_range = True
+    backend = "direct"
 
-    def __init__(self, radius: float):
+    def __init__(self, radius: float, threads: int = 1):
         self.radius = float(radius)
         self.self_mobility = 1.0 / (6.0 * math.pi * self.radius)
+        self.threads = int(threads)
 
     def apply(self, x, F):
         x = np.ascontiguousarray(x, dtype=np.float64)
         F = np.ascontiguousarray(F, dtype=np.float64)
         out = np.empty_like(F)
-        K.rpy_apply(x, self.radius, F, out)
+        K.rpy_apply(x, self.radius, F, out, self.threads)
         return out
 
     def matrix(self, x):
@@ -65,6 +80,117 @@ class RPYMobility(Mobility):
         out = np.empty((3 * n, 3 * n))
         K.rpy_matrix(x, self.radius, out)
         return out
+
+
+class FMMMobility(RPYMobility):
+    """RPY product by the fast multipole method (FMM3D), O(n) per product.
+
+    For ``r >= 2a`` the RPY tensor is the Oseen tensor plus a potential dipole,
+    ``mu_hat = (I + rr)/(8 pi r) + a^2/(12 pi) (I/r^3 - 3 rr/r^5)`` (Liang et al. 2013,
+    Eq. 8): one Stokeslet FMM (FMM3D's Stokeslet is already ``(I/r + rr/r^3)/(8 pi)``) and
+    one Laplace FMM of dipoles ``F`` whose gradient, times ``4 pi a^2/(12 pi) = a^2/3``,
+    gives the second term (FMM3D's Laplace kernel carries ``1/(4 pi)``). Pairs closer than
+    ``2a`` (found with a k-d tree) are corrected to the overlap form exactly. ``eps`` is
+    FMM3D's requested relative precision.
+    """
+
+    backend = "fmm"
+
+    def __init__(self, radius: float, eps: float = 1e-10, threads: int = 1):
+        super().__init__(radius, threads)
+        import fmm3dpy  # noqa: F401  (fail at construction, not mid-run)
+
+        self.eps = float(eps)
+
+    def apply(self, x, F):
+        import fmm3dpy
+        from scipy.spatial import cKDTree
+
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        F = np.ascontiguousarray(F, dtype=np.float64)
+        n = len(x)
+        src = np.ascontiguousarray(x.T)
+        ft = np.ascontiguousarray(F.T)
+        st = fmm3dpy.stfmm3d(eps=self.eps, sources=src, stoklet=ft, ifppreg=1)
+        lp = fmm3dpy.lfmm3d(eps=self.eps, sources=src, dipvec=ft, pg=2)
+        out = st.pot.reshape(3, n).T + (self.radius ** 2 / 3.0) * lp.grad.reshape(3, n).T
+        out += self.self_mobility * F
+        pairs = cKDTree(x).query_pairs(2.0 * self.radius, output_type="ndarray")
+        if len(pairs):
+            K.rpy_overlap_correction(x, self.radius, pairs.astype(np.int64), F, out)
+        return np.ascontiguousarray(out)
+
+
+class JAXMobility(RPYMobility):
+    """The RPY direct sum in JAX (float64), jitted; runs on a GPU when jax has one.
+
+    Rows are processed in blocks of ``block`` so memory stays O(block * n), not O(n^2).
+    """
+
+    backend = "jax"
+
+    def __init__(self, radius: float, block: int = 1024, threads: int = 1):
+        super().__init__(radius, threads)
+        self._fn = _jax_rpy(float(radius), int(block))
+
+    def apply(self, x, F):
+        return np.asarray(self._fn(np.asarray(x, dtype=np.float64),
+                                   np.asarray(F, dtype=np.float64)))
+
+
+def _jax_rpy(a: float, block: int):
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+    import jax.numpy as jnp
+
+    s = 1.0 / (6.0 * math.pi * a)
+
+    def rows(xb, x, F):
+        d = xb[:, None, :] - x[None, :, :]
+        r2 = jnp.maximum(jnp.sum(d * d, axis=-1), 1e-32 * a * a)
+        ir = 1.0 / jnp.sqrt(r2)
+        q = a * a * ir * ir
+        far = r2 >= 4.0 * a * a
+        f = jnp.where(far, ir / (8 * math.pi) * (1 + 2 * q / 3), s * (1 - 9 * r2 * ir / (32 * a)))
+        g = jnp.where(far, ir ** 3 / (8 * math.pi) * (1 - 2 * q), s * 3 * ir / (32 * a))
+        dF = jnp.einsum("ijk,jk->ij", d, F)
+        return f @ F + jnp.einsum("ij,ijk->ik", g * dF, d)
+
+    @jax.jit
+    def apply(x, F):
+        n = x.shape[0]
+        nb_ = -(-n // block)
+        pad = nb_ * block - n
+        xp = jnp.pad(x, ((0, pad), (0, 0)))
+        out = jax.lax.map(lambda xb: rows(xb, x, F), xp.reshape(nb_, block, 3))
+        return out.reshape(-1, 3)[:n]
+
+    return apply
+
+
+def jax_gpu_available() -> bool:
+    """True when jax is installed and sees a GPU (never raises)."""
+    try:
+        import jax
+
+        return any(d.platform == "gpu" for d in jax.devices())
+    except Exception:  # noqa: BLE001 - any failure means "no GPU backend here"
+        return False
+
+
+BACKENDS = ("auto", "direct", "fmm", "jax")
+GPU_AUTO_MIN_BEADS = 2000  # estimate, not measured here (no GPU in this project's sessions)
+
+
+def backend_missing(name: str) -> str | None:
+    """Why backend ``name`` cannot run here (missing package), or None if it can."""
+    import importlib.util
+
+    need = {"fmm": "fmm3dpy", "jax": "jax"}.get(name)
+    if need and importlib.util.find_spec(need) is None:
+        return f"needs the {need} package (pip install {need})"
+    return None
 
 
 class LocalMobility(Mobility):
@@ -83,5 +209,17 @@ class LocalMobility(Mobility):
         return self.self_mobility * np.eye(3 * len(x))
 
 
-def make_mobility(hydrodynamics: bool, radius: float) -> Mobility:
-    return RPYMobility(radius) if hydrodynamics else LocalMobility(radius)
+def make_mobility(hydrodynamics: bool, radius: float, backend: str = "auto", n: int = 0,
+                  threads: int = 1, fmm_eps: float = 1e-10) -> Mobility:
+    """The mobility for ``n`` active beads (``backend`` as in the module docstring)."""
+    if not hydrodynamics:
+        return LocalMobility(radius)
+    if backend not in BACKENDS:
+        raise ValueError(f"mobility backend must be one of {BACKENDS}, got {backend!r}")
+    if backend == "auto":
+        backend = "jax" if n >= GPU_AUTO_MIN_BEADS and jax_gpu_available() else "direct"
+    if backend == "fmm":
+        return FMMMobility(radius, eps=fmm_eps, threads=threads)
+    if backend == "jax":
+        return JAXMobility(radius, threads=threads)
+    return RPYMobility(radius, threads=threads)

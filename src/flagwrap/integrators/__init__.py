@@ -8,11 +8,11 @@ from flagwrap.integrators.rosenbrock import ROS2
 REGISTRY = {"ros34pw2": ROS34PW2, "ros2": ROS2, "euler": ExplicitEuler}
 
 
-def make_integrator(name: str, tol: float = 1e-5) -> Integrator:
+def make_integrator(name: str, tol: float = 1e-5, linear_solver: str = "auto") -> Integrator:
     if name not in REGISTRY:
         raise ValueError(f"unknown integrator {name!r}; known: {', '.join(REGISTRY)}")
     cls = REGISTRY[name]
-    return cls() if name == "euler" else cls(tol=tol)
+    return cls() if name == "euler" else cls(tol=tol, linear_solver=linear_solver)
 
 
 __all__ = ["Integrator", "StepResult", "ExplicitEuler", "ROS2", "ROS34PW2", "make_integrator",

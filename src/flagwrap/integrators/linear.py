@@ -93,6 +93,38 @@ class KrylovW:
         return u
 
 
+class NearW:
+    """Approximate ``W = I - gamma h Mob_near J`` with the chain-local hydrodynamics only.
+
+    ROS34PW2 and ROS2 are *W-methods*: their order holds for any ``W`` (Rang & Angermann
+    2005), so ``W`` may drop the far-field hydrodynamics while every stage still sees the
+    full mobility through ``f``. What is dropped only matters for stability on the stiff
+    modes, and those are short-wavelength (bond stretch, twist, one-bond bending) whose
+    forces alternate in sign along the chain, so their far field cancels. Cost per step:
+    one sparse banded LU, O(N) in time and memory, plus one full ``Mob F`` per stage.
+    ``width`` (beads along the chain kept in ``Mob_near``) defaults to
+    :meth:`RodSystem.near_field_mobility`'s overlap range + 4.
+    """
+
+    def __init__(self, system, y, base, G0, gamma_h, width=None):
+        import scipy.sparse as sp
+        import scipy.sparse.linalg as spla
+
+        J = system.force_jacobian_sparse(y, base, G0)
+        Mnear = system.near_field_mobility(y, width)
+        W = sp.identity(system.ny, format="csc") - gamma_h * (Mnear @ J).tocsc()
+        try:
+            self.lu = spla.splu(W)
+        except RuntimeError as exc:
+            raise SingularW(str(exc)) from None
+
+    def solve(self, rhs):
+        u = self.lu.solve(rhs)
+        if not np.all(np.isfinite(u)):
+            raise SingularW("non-finite solve")
+        return u
+
+
 class SparseW:
     """Sparse direct solve for a local (diagonal) mobility: ``W`` is banded, O(N) to factorise.
 
@@ -134,4 +166,6 @@ def make_w(kind, system, y, base, G0, gamma_h):
         return DenseW(system, y, base, G0, gamma_h)
     if kind == "krylov":
         return KrylovW(system, y, base, G0, gamma_h)
+    if kind == "near":
+        return NearW(system, y, base, G0, gamma_h)
     raise ValueError(f"unknown linear solver {kind!r}")

@@ -165,9 +165,11 @@ def _toml_value(v) -> str:
     raise TypeError(type(v))
 
 
-def config_to_toml(cfg: Config) -> str:
-    """Serialise a config (SI units) to TOML text that :func:`load_config` reads back."""
-    d = cfg.to_dict()
+def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
+    """Serialise a config (SI units) to TOML text that :func:`load_config` reads back.
+
+    ``for_hash``: the text result keys are computed from (see ``Config.to_dict``)."""
+    d = cfg.to_dict(for_hash=for_hash)
     lines = [f"name = {_toml_value(d.pop('name'))}", ""]
     for section in ("filament", "fluid", "body", "motor", "clamp", "contact", "numerics"):
         table = d.get(section, {})

@@ -210,7 +210,7 @@ class Case:
         from flagwrap import __version__
 
         cfg = self.config().replace(name="run")
-        payload = {"config": cfg.to_dict(), "stop_after": self.run.get("stop_after"),
+        payload = {"config": cfg.to_dict(for_hash=True), "stop_after": self.run.get("stop_after"),
                    "version": __version__}
         if self.runner is not None:  # a non-default case function makes other results
             payload["runner"] = self.runner
