@@ -377,11 +377,11 @@ class Numerics:
         N >= 2000. All agree to 1e-10 (fmm: to ``mobility_tol``).
     mobility_tol : float
         requested relative precision of the FMM backend.
-    linear_solver : {"auto", "dense", "near", "krylov", "sparse"}
+    linear_solver : {"auto", "dense", "near", "krylov", "banded", "sparse"}
         solver of the Rosenbrock stage equations (:mod:`flagwrap.integrators.linear`): exact
         dense LU, sparse LU of the near-field ``W`` (a W-method approximation, O(N)), GMRES,
-        or exact sparse LU (HI off only). "auto": sparse with HI off; dense up to
-        ``AUTO_CROSSOVER_NY`` unknowns, near above.
+        or exact banded / sparse LU (HI off only). "auto": banded with HI off; with HI dense
+        up to ``AUTO_CROSSOVER_NY`` unknowns, near above.
     dt_min : float
         smallest step [turns] before the run is declared stuck.
     save_every : float
@@ -417,13 +417,14 @@ class Numerics:
         tol_m = _positive("numerics.mobility_tol", self.mobility_tol)
         if tol_m > 1e-2:
             raise UserInputError(f"numerics.mobility_tol must be in (0, 1e-2], got {tol_m}")
-        solvers = ("auto", "dense", "near", "krylov", "sparse")
+        solvers = ("auto", "dense", "near", "krylov", "banded", "sparse")
         if self.linear_solver not in solvers:
             raise UserInputError(f"numerics.linear_solver must be one of {', '.join(solvers)}, "
                                  f"got {self.linear_solver!r}")
-        if self.linear_solver == "sparse" and self.hydrodynamics:
-            raise UserInputError("numerics.linear_solver = 'sparse' needs numerics.hydrodynamics = "
-                                 "false (it is exact only for a local mobility); use 'auto'")
+        if self.linear_solver in ("banded", "sparse") and self.hydrodynamics:
+            raise UserInputError(f"numerics.linear_solver = {self.linear_solver!r} needs "
+                                 "numerics.hydrodynamics = false (it is exact only for a local "
+                                 "mobility); use 'auto'")
         if self.integrator not in ("ros34pw2", "ros2", "euler"):
             raise UserInputError(
                 "numerics.integrator must be 'ros34pw2', 'ros2' or 'euler', "

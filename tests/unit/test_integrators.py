@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flagwrap.integrators import ROS2, ROS34PW2, ExplicitEuler
-from flagwrap.integrators.linear import DenseW, KrylovW, SparseW
+from flagwrap.integrators.linear import BandedW, DenseW, KrylovW, SparseW
 from flagwrap.integrators.ros34pw2 import A_T, C_T, GAMMA, M_T
 from flagwrap.model import RodSystem
 
@@ -146,6 +146,10 @@ def test_sparse_solver_matches_dense_without_hydrodynamic_interactions():
     ud = DenseW(s, y, info.frames, info.G, 1e-2).solve(r)
     us = SparseW(s, y, info.frames, info.G, 1e-2).solve(r)
     assert np.abs(ud - us).max() <= 1e-9 * np.abs(ud).max()
+    bw = BandedW(s, y, info.frames, info.G, 1e-2)
+    ub = bw.solve(r)
+    assert np.abs(ud - ub).max() <= 1e-9 * np.abs(ud).max()
+    assert bw.kl <= 12 and bw.ku <= 12  # interleaved beads/twists: O(N) band, not dense
 
 
 def _run_with(solver, protocol, n_beads=31, tol=1e-5):

@@ -90,6 +90,7 @@ def test_nonlocal_distance_of_a_tight_helix_is_the_pitch():
     ({"mobility_tol": 0.5}, "mobility_tol"),
     ({"linear_solver": "lu"}, "linear_solver"),
     ({"linear_solver": "sparse"}, "hydrodynamics"),
+    ({"linear_solver": "banded"}, "hydrodynamics"),
 ])
 def test_numerics_backend_choices_are_checked(kw, match):
     from flagwrap.params import Numerics
