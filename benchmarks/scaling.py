@@ -1,15 +1,24 @@
 """Cost of one mobility product and one full step against the number of beads N.
 
-Run: ``python benchmarks/scaling.py [--max-n 16000]``
+Run: ``python benchmarks/scaling.py [--max-n 16000] [--threads 2]``
 
-For N = 61, 250, 1000, 4000, 16000 (the Fig. 4(a) helix, HI on, one core):
+The chain is the Fig. 4(a) helix (R = 30 mm, pitch, a = 1.5 mm, bond b = L/60) made longer at
+the same bond length, so N beads are a filament of length (N - 1) b: the "long filament" of
+issue 3 (at N = 61 it is exactly the paper's case). Keeping b/a fixed keeps the near field
+(overlapping neighbours) the same size per bead, so memory can be linear in N. One core
+(BLAS and numba limited to one thread) unless ``--threads``.
 
-* mobility product ``Mob F``: numba matrix-free O(N^2) product (``rpy_apply``) and, where the
-  3N x 3N matrix fits comfortably (N <= 1000), dense assembly + matvec;
-* one ROS34PW2 step with each linear solver (dense LU / matrix-free GMRES), N <= 1000;
-* peak Python-heap memory of one force + mobility evaluation (tracemalloc), to show O(N).
+For N = 61, 250, 1000, 4000, 16000:
 
-Prints a table and the measured dense/Krylov crossover.
+* ``Mob F`` with each mobility backend installed here: ``direct`` (numba, vectorised),
+  ``direct x T`` (numba threads, only with ``--threads`` > 1), ``fmm`` (FMM3D, eps 1e-6 and
+  1e-10), ``jax`` (on whatever device jax has; CPU here), each checked against ``direct``;
+* one ROS34PW2 step with each stage solver: ``dense`` (exact LU, N <= 1000), ``near``
+  (near-field W-method, sparse LU, O(N)), ``krylov`` (GMRES, N <= 250: ~150 iterations);
+* peak traced memory (tracemalloc: numpy buffers) of one ``near`` step, to show O(N).
+
+Prints a table, the crossover N where FMM beats the direct sum (if any), and the steps per
+second of the ``near`` and ``dense`` steppers at N = 1000.
 """
 
 from __future__ import annotations
@@ -22,6 +31,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from flagwrap.cases import get_case
+from flagwrap.hydrodynamics.mobility import (FMMMobility, JAXMobility, RPYMobility,
+                                             backend_missing)
 from flagwrap.integrators.ros34pw2 import ROS34PW2
 from flagwrap.model import RodSystem
 from flagwrap.params import Filament
@@ -30,7 +41,8 @@ from flagwrap.params import Filament
 def system_for(N):
     cfg = get_case("fig4a")
     fil = cfg.filament
-    fil = Filament(length=fil.length, helix_radius=fil.helix_radius, pitch=fil.pitch,
+    b = fil.length / (fil.n_beads - 1)
+    fil = Filament(length=b * (N - 1), helix_radius=fil.helix_radius, pitch=fil.pitch,
                    cross_section_radius=fil.cross_section_radius,
                    youngs_modulus=fil.youngs_modulus, n_beads=N)
     return RodSystem(cfg.replace(filament=fil))
@@ -48,9 +60,20 @@ def best_of(fn, repeat):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--max-n", type=int, default=16000)
+    ap.add_argument("--threads", type=int, default=1)
     args = ap.parse_args()
     sizes = [n for n in (61, 250, 1000, 4000, 16000) if n <= args.max_n]
-    rows = []
+    backends = {"direct": lambda a: RPYMobility(a)}
+    if args.threads > 1:
+        backends[f"direct x{args.threads}"] = lambda a: RPYMobility(a, threads=args.threads)
+    if backend_missing("fmm") is None:
+        backends["fmm 1e-6"] = lambda a: FMMMobility(a, eps=1e-6)
+        backends["fmm 1e-10"] = lambda a: FMMMobility(a, eps=1e-10)
+    if backend_missing("jax") is None:
+        backends["jax"] = lambda a: JAXMobility(a)
+    print("backends:", ", ".join(backends), flush=True)
+    prod = {}
+    steps = {}
     with threadpool_limits(1):
         for N in sizes:
             s = system_for(N)
@@ -60,36 +83,52 @@ def main():
             info = s.forces(y, s.frames0)
             x = info.x[s.nc:]
             F = rng.standard_normal(x.shape)
-            rep = 5 if N <= 1000 else 1
-            s.mobility.apply(x, F)  # compile
-            t_mf = best_of(lambda: s.mobility.apply(x, F), rep)
-            t_dense = np.nan
-            if N <= 1000:
-                t_dense = best_of(lambda: s.mobility.matrix(x) @ F.ravel(), rep)
-            tracemalloc.start()
-            inf2 = s.forces(y, s.frames0)
-            s.apply_mobility(y, inf2.G)
-            peak = tracemalloc.get_traced_memory()[1]
-            tracemalloc.stop()
-            step = {}
-            if N <= 1000:
-                for kind in ("dense", "krylov"):
-                    integ = ROS34PW2(tol=1e-5, linear_solver=kind)
-                    h = 1e-3 * 2 * np.pi
-                    integ.step(s, y, info.frames, info, h, 1.0)  # compile / warm
-                    step[kind] = best_of(lambda: integ.step(s, y, info.frames, info, h, 1.0),
-                                         2 if N <= 250 else 1)
-            rows.append((N, t_mf, t_dense, step.get("dense", np.nan), step.get("krylov", np.nan),
-                         peak / 1e6))
-            print(f"N={N:6d}  Mob F matrix-free {t_mf * 1e3:9.3f} ms  dense {t_dense * 1e3:9.3f} ms  "
-                  f"step dense {step.get('dense', np.nan):8.4f} s  step krylov "
-                  f"{step.get('krylov', np.nan):8.4f} s  heap {peak / 1e6:8.2f} MB", flush=True)
-    cross = [r[0] for r in rows if np.isfinite(r[3]) and np.isfinite(r[4]) and r[4] < r[3]]
-    print("crossover (first N where the Krylov step beats dense):", cross[0] if cross else "none measured")
-    big = [r for r in rows if r[0] >= 1000]
+            ref = None
+            line = [f"N={N:6d}  Mob F:"]
+            for name, make in backends.items():
+                mob = make(s.radius)
+                out = mob.apply(x, F)  # compile / warm
+                if ref is None:
+                    ref = out
+                err = np.linalg.norm(out - ref) / np.linalg.norm(ref)
+                rep = 5 if N <= 1000 else (2 if N <= 4000 else 1)
+                t = best_of(lambda: mob.apply(x, F), rep)
+                prod[(N, name)] = t
+                line.append(f"{name} {t * 1e3:.3f} ms (rel.err {err:.0e})")
+            print("  ".join(line), flush=True)
+            h = 1e-3 * 2 * np.pi
+            line = ["          step:"]
+            for kind in ("dense", "near", "krylov"):
+                if (kind == "dense" and N > 1000) or (kind == "krylov" and N > 250):
+                    continue
+                integ = ROS34PW2(tol=1e-5, linear_solver=kind)
+                integ.step(s, y, info.frames, info, h, 1.0)  # compile / warm
+                if kind == "near":
+                    tracemalloc.start()
+                    t = best_of(lambda: integ.step(s, y, info.frames, info, h, 1.0), 1)
+                    peak = tracemalloc.get_traced_memory()[1]
+                    tracemalloc.stop()
+                    line.append(f"near {t:.4f} s (peak {peak / 1e6:.1f} MB)")
+                    steps[(N, kind)] = (t, peak)
+                else:
+                    t = best_of(lambda: integ.step(s, y, info.frames, info, h, 1.0),
+                                2 if N <= 250 else 1)
+                    steps[(N, kind)] = (t, None)
+                    line.append(f"{kind} {t:.4f} s")
+            print("  ".join(line), flush=True)
+    fmm = [n for n in sizes if (n, "fmm 1e-6") in prod and prod[(n, "fmm 1e-6")] < prod[(n, "direct")]]
+    if any(k[1].startswith("fmm") for k in prod):
+        print("FMM (eps 1e-6) faster than the direct sum from N =", fmm[0] if fmm else
+              f"never up to N = {sizes[-1]}")
+    if (1000, "near") in steps:
+        msg = f"N = 1000: near stepper {1 / steps[(1000, 'near')][0]:.1f} steps/s"
+        if (1000, "dense") in steps:
+            msg += f", dense {1 / steps[(1000, 'dense')][0]:.2f} steps/s"
+        print(msg)
+    big = [(n, steps[(n, "near")][1]) for n in sizes if n >= 1000 and (n, "near") in steps]
     if len(big) >= 2:
-        (n1, m1), (n2, m2) = (big[0][0], big[0][5]), (big[-1][0], big[-1][5])
-        print(f"memory growth {n1} -> {n2} beads: x{m2 / m1:.1f} for x{n2 / n1:.0f} beads (linear)")
+        (n1, m1), (n2, m2) = big[0], big[-1]
+        print(f"near-step memory {n1} -> {n2} beads: x{m2 / m1:.1f} for x{n2 / n1:.0f} beads")
 
 
 if __name__ == "__main__":

@@ -377,6 +377,10 @@ class Numerics:
         N >= 2000. All agree to 1e-10 (fmm: to ``mobility_tol``).
     mobility_tol : float
         requested relative precision of the FMM backend.
+    max_wall_time : float
+        wall-clock budget of one run in seconds (0: none). A run that exceeds it stops with
+        status "failed", a message naming this option, and every frame computed so far (a
+        sweep records the case as failed; ``flagwrap sweep --retry-failed`` reruns it).
     linear_solver : {"auto", "dense", "near", "krylov", "banded", "sparse"}
         solver of the Rosenbrock stage equations (:mod:`flagwrap.integrators.linear`): exact
         dense LU, sparse LU of the near-field ``W`` (a W-method approximation, O(N)), GMRES,
@@ -401,9 +405,11 @@ class Numerics:
     mobility_backend: str = "auto"
     mobility_tol: float = 1e-10
     linear_solver: str = "auto"
+    max_wall_time: float = 0.0
 
     # performance options left out of result keys at their defaults (Config.to_dict(for_hash))
-    HASH_OMIT_DEFAULTS = {"mobility_backend": "auto", "mobility_tol": 1e-10, "linear_solver": "auto"}
+    HASH_OMIT_DEFAULTS = {"mobility_backend": "auto", "mobility_tol": 1e-10, "linear_solver": "auto",
+                          "max_wall_time": 0.0}
 
     def __post_init__(self):
         from flagwrap.hydrodynamics.mobility import BACKENDS, backend_missing
@@ -417,6 +423,10 @@ class Numerics:
         tol_m = _positive("numerics.mobility_tol", self.mobility_tol)
         if tol_m > 1e-2:
             raise UserInputError(f"numerics.mobility_tol must be in (0, 1e-2], got {tol_m}")
+        if isinstance(self.max_wall_time, bool) or not isinstance(self.max_wall_time, (int, float)) \
+                or not math.isfinite(self.max_wall_time) or self.max_wall_time < 0:
+            raise UserInputError(f"numerics.max_wall_time must be a number of seconds >= 0 "
+                                 f"(0: no limit), got {self.max_wall_time!r}")
         solvers = ("auto", "dense", "near", "krylov", "banded", "sparse")
         if self.linear_solver not in solvers:
             raise UserInputError(f"numerics.linear_solver must be one of {', '.join(solvers)}, "

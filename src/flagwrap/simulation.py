@@ -92,6 +92,7 @@ class Simulation:
         self.save_dt = num.save_every * TWO_PI
         self.max_steps = num.max_steps
         self.max_strain_limit = max_strain
+        self.max_wall = float(num.max_wall_time)
 
     def _record(self, traj, t, y, info, omega):
         s = self.system
@@ -253,6 +254,11 @@ class Simulation:
                     next_save += self.save_dt
                 if traj.n_steps >= self.max_steps:
                     raise _Stop(f"t/T={t / TWO_PI:.6g}: reached numerics.max_steps={self.max_steps}")
+                if self.max_wall and _time.perf_counter() - start + wall0 > self.max_wall:
+                    if traj.t[-1] < t - eps:
+                        self._record(traj, t, y, info, omega)
+                    raise _Stop(f"t/T={t / TWO_PI:.6g}: wall time above numerics.max_wall_time="
+                                f"{self.max_wall:g} s")
                 if ck_on:
                     now = _time.perf_counter()
                     if (ck_steps > 0 and traj.n_steps % ck_steps == 0) or \

@@ -67,6 +67,20 @@ def test_step_size_floor(tmp_path):
     assert ds.attrs["status"] == "failed" and len(ds["time"]) == 1  # the initial frame
 
 
+def test_wall_time_budget_stops_the_run_and_keeps_its_frames(tmp_path):
+    cfg = _cfg(tol=1e-7, max_wall_time=0.5)  # tight tol: the 0.6-turn run needs several seconds
+    traj = simulate(cfg)
+    assert traj.status == "failed"
+    assert re.match(r"t/T=[0-9.e-]+: wall time above numerics.max_wall_time=0.5 s", traj.message), \
+        traj.message
+    assert 0 < traj.t[-1] < 0.6 * 2 * np.pi and len(traj.t) >= 2
+    out = tmp_path / "wall.nc"
+    write_run(traj, out)
+    assert read_run(out).attrs["status"] == "failed"
+    with pytest.raises(UserInputError, match="max_wall_time"):
+        _cfg(max_wall_time=-1.0)
+
+
 def test_non_finite_force_and_body_entry_guards_name_the_bead():
     cfg = _cfg()
     sim = Simulation(cfg)

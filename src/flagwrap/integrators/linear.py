@@ -9,10 +9,18 @@
   ``4a/b + 4`` along the chain), which governs the stiff short-wavelength modes: with the self
   mobility alone GMRES needed >100 iterations at N = 241 (overlapping beads).
 
-* :class:`SparseW` is the exact sparse LU when the mobility is local (HI off): banded, O(N).
+* :class:`NearW` drops the far field from ``W`` altogether (a W-method keeps its order for
+  any ``W``): one sparse LU, O(N), and one full ``Mob F`` per stage. Its error estimate is
+  looser and the long-wavelength stretching modes, whose relaxation the far field speeds up,
+  limit its step: it takes ~10-15x the steps of the exact ``W`` (N = 500 long chain, 0.01
+  turn: 846 steps + 292 rejections vs 59 + 18), each far cheaper at large N.
+* :class:`BandedW` (default with HI off) and :class:`SparseW` are exact LUs for a local
+  mobility: banded, O(N).
 
-``make_w(kind, ...)`` picks one; ``"auto"`` switches at ``ny > 4000`` (N ~ 1000), a crossover
-measured in benchmarks/scaling.py.
+``make_w(kind, ...)`` picks one; ``"auto"``: banded with HI off, dense up to
+``AUTO_CROSSOVER_NY`` unknowns, near above. The crossover is where the two took the same
+wall time to cover 0.01 turn of the long-chain case (N = 500: near 38 s, dense 50 s, on the
+loaded 2-core machine; docs/numerics.md).
 """
 
 from __future__ import annotations
@@ -20,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-AUTO_CROSSOVER_NY = 4000
+AUTO_CROSSOVER_NY = 2000
 
 
 class SingularW(Exception):
@@ -235,7 +243,7 @@ def make_w(kind, system, y, base, G0, gamma_h):
         if not system.mobility.long_range:
             kind = "banded"
         else:
-            kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "krylov"
+            kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "near"
     if kind == "banded":
         return BandedW(system, y, base, G0, gamma_h)
     if kind == "sparse":
