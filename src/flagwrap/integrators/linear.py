@@ -1,26 +1,28 @@
 """Linear solvers for the Rosenbrock stage equations ``W u = r``, ``W = I - gamma h Mob J``.
 
 * :class:`DenseW` assembles ``W`` (ny x ny) and LU-factorises it once per step: fastest for
-  small chains (N ~ 60 -> ny ~ 240), O(N^3) time and O(N^2) memory.
+  short chains (N ~ 60 -> ny ~ 240), O(N^3) time and O(N^2) memory.
 * :class:`KrylovW` never forms a dense matrix: ``J`` is sparse (banded, from the coloured
   Jacobian), ``Mob`` is applied matrix-free (O(N^2) RPY product, O(N) memory) and GMRES is
-  preconditioned by the near-field operator ``I - gamma h Mob_near J`` (sparse LU). Used for
-  long chains. The preconditioner keeps the near-field hydrodynamics (bead pairs within
-  ``4a/b + 4`` along the chain), which governs the stiff short-wavelength modes: with the self
-  mobility alone GMRES needed >100 iterations at N = 241 (overlapping beads).
-
+  preconditioned by the near-field operator ``I - gamma h Mob_near J`` (sparse LU). It solves
+  to a relative residual ``rtol = 1e-3``: the stage increments are ~|dy| per step ~1e-3 L, so
+  the solve error (~1e-6 L) stays below the step tolerance 1e-5 L. Measured on the long
+  chain (benchmarks/scaling.py's, 0.01 turn): the same accepted steps as the exact LU (N =
+  500: 60 vs 59), free end equal to 1e-5 L, 6-8 GMRES iterations per stage (~150 at rtol
+  1e-10). The preconditioner keeps the near-field hydrodynamics (bead pairs within
+  ``4a/b + 4`` along the chain), which governs the stiff short-wavelength modes.
 * :class:`NearW` drops the far field from ``W`` altogether (a W-method keeps its order for
-  any ``W``): one sparse LU, O(N), and one full ``Mob F`` per stage. Its error estimate is
-  looser and the long-wavelength stretching modes, whose relaxation the far field speeds up,
-  limit its step: it takes ~10-15x the steps of the exact ``W`` (N = 500 long chain, 0.01
-  turn: 846 steps + 292 rejections vs 59 + 18), each far cheaper at large N.
+  any ``W``): one sparse LU and one full ``Mob F`` per stage. Its error estimate is looser and
+  the long-wavelength stretching modes, whose relaxation the far field speeds up, limit its
+  step: ~15x the steps of the exact ``W`` (N = 500: 846 steps + 292 rejections vs 59 + 18),
+  so it lost to KrylovW everywhere measured; kept as an option.
 * :class:`BandedW` (default with HI off) and :class:`SparseW` are exact LUs for a local
   mobility: banded, O(N).
 
 ``make_w(kind, ...)`` picks one; ``"auto"``: banded with HI off, dense up to
-``AUTO_CROSSOVER_NY`` unknowns, near above. The crossover is where the two took the same
-wall time to cover 0.01 turn of the long-chain case (N = 500: near 38 s, dense 50 s, on the
-loaded 2-core machine; docs/numerics.md).
+``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover is measured (0.01-0.5 turn of the
+long chain, same steps both ways): N = 61 dense 2.0 s vs krylov 5.1 s; N = 120 2.7 vs 2.5 s;
+N = 250 2.2 vs 1.1 s; N = 500 50 vs 6.0 s (docs/numerics.md).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-AUTO_CROSSOVER_NY = 2000
+AUTO_CROSSOVER_NY = 500
 
 
 class SingularW(Exception):
@@ -59,9 +61,9 @@ class DenseW:
 
 
 class KrylovW:
-    """Matrix-free ``W`` with a sparse local-drag preconditioner (GMRES, relative tol ``rtol``)."""
+    """Matrix-free ``W`` with a sparse near-field preconditioner (GMRES, relative tol ``rtol``)."""
 
-    def __init__(self, system, y, base, G0, gamma_h, rtol=1e-10, maxiter=200):
+    def __init__(self, system, y, base, G0, gamma_h, rtol=1e-3, maxiter=200):
         import scipy.sparse as sp
         import scipy.sparse.linalg as spla
 
@@ -243,7 +245,7 @@ def make_w(kind, system, y, base, G0, gamma_h):
         if not system.mobility.long_range:
             kind = "banded"
         else:
-            kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "near"
+            kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "krylov"
     if kind == "banded":
         return BandedW(system, y, base, G0, gamma_h)
     if kind == "sparse":
