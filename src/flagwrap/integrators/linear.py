@@ -145,11 +145,13 @@ def _band_structure(system, rows, cols):
     import scipy.sparse as sp
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-    cached = getattr(system, "_band_cache", None)
-    if cached is not None and cached[0] == len(rows):
-        return cached[1:]
     n = system.ny - 1
     keep = (rows < n) & (cols < n)
+    # the motor-angle column's non-zeros vary between calls; the rest of the pattern does not
+    nkeep = int(keep.sum())
+    cached = getattr(system, "_band_cache", None)
+    if cached is not None and cached[0] == nkeep:
+        return cached[1:]
     A = sp.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(n, n))
     A = A + A.T + sp.identity(n, format="csr")
     perm = np.asarray(reverse_cuthill_mckee(A.tocsr(), symmetric_mode=True), dtype=np.int64)
@@ -158,7 +160,7 @@ def _band_structure(system, rows, cols):
     r, c = inv[rows[keep]], inv[cols[keep]]
     kl = int(max(0, (r - c).max()))
     ku = int(max(0, (c - r).max()))
-    system._band_cache = (len(rows), perm, inv, kl, ku)
+    system._band_cache = (nkeep, perm, inv, kl, ku)
     return perm, inv, kl, ku
 
 
