@@ -48,7 +48,7 @@ def unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta):
 @nb.njit(cache=True)
 def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
                        base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
-                       has_body, Rc, H, sigma, eps, gravity,
+                       has_body, Rc, H, sigma, eps, c2, gravity,
                        G, x, theta, gx, gth, d1_out, rt_out, dist):
     """Fill ``G`` (ny,) and the work arrays; return (elastic energy, contact energy)."""
     N = x.shape[0]
@@ -57,7 +57,7 @@ def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
                     gx, gth, d1_out, rt_out)
     Ec = 0.0
     if has_body:
-        Ec = wca_energy_grad(x, nc, Rc, H, sigma, eps, gx, dist)
+        Ec = wca_energy_grad(x, nc, Rc, H, sigma, eps, c2, gx, dist)
     else:
         for i in range(N):
             dist[i] = np.inf
@@ -80,7 +80,7 @@ def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
 def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
                     nc, ec, x_ref, axis, theta_ref, twist_rate,
                     base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
-                    has_body, Rc, H, sigma, eps, gravity):
+                    has_body, Rc, H, sigma, eps, c2, gravity):
     """``J = dG/dy`` as COO triplets (duplicates to be summed), O(N) time and memory.
 
     Analytic stretching Hessian + coloured differences of the rest. The stretching springs are
@@ -109,14 +109,14 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
     vals = np.empty(n_tot)
     generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, vor, kbar, mbar, A, C, 0.0, has_body, Rc, H, sigma,
-                       eps, gravity, Gs, x, theta, gx, gth, d1, rt, dist)
+                       eps, c2, gravity, Gs, x, theta, gx, gth, d1, rt, dist)
     n_groups = g_ptr.shape[0] - 1
     for g in range(n_groups):
         for q in range(g_ptr[g], g_ptr[g + 1]):
             yp[g_cols[q]] += delta
         generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                            base_rt, l0, vor, kbar, mbar, A, C, 0.0, has_body, Rc, H, sigma,
-                           eps, gravity, G, x, theta, gx, gth, d1, rt, dist)
+                           eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist)
         for q in range(e_ptr[g], e_ptr[g + 1]):
             r = e_rows[q]
             rows[q] = r
@@ -153,7 +153,7 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
     yp[ny - 1] += delta
     generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, vor, kbar, mbar, A, C, ks, has_body, Rc, H, sigma,
-                       eps, gravity, G, x, theta, gx, gth, d1, rt, dist)
+                       eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist)
     for r in range(ny):
         v = (G[r] - G0[r]) / delta
         if v != 0.0:

@@ -103,6 +103,7 @@ class RodSystem:
                 cutoff=fil.cross_section_radius * (1.0 + config.contact.range) / L,
                 strength=config.contact.strength / b,
                 first_bead=nc,
+                potential=config.contact.potential,
             )
         else:
             self.body = body or NoBody()
@@ -145,7 +146,7 @@ class RodSystem:
                 base.t, base.d1, base.rt, r.l0, r.vor, r.kbar, r.mbar, r.bending, r.twist,
                 r.stretch, has_body, b.radius if has_body else 0.0,
                 b.length if has_body else 0.0, b.sigma if has_body else 0.0,
-                b.strength if has_body else 0.0, self.gravity)
+                b.strength if has_body else 0.0, b.c2 if has_body else 0.0, self.gravity)
 
     def forces(self, y: np.ndarray, base: Frames) -> ForceInfo:
         """Generalized forces ``G = -dU/dy`` and everything computed with them."""

@@ -39,14 +39,19 @@ def surface_distance(px, py, pz, Rc, H):
 
 
 @nb.njit(cache=True)
-def wca_energy_grad(x, first, Rc, H, sigma, eps, grad, dist):
+def wca_energy_grad(x, first, Rc, H, sigma, eps, c2, grad, dist):
     """WCA repulsion of beads ``first..`` from the body; adds dU/dx to ``grad``.
 
-    ``U(d) = 4 eps [(sigma/d)^12 - (sigma/d)^6] + eps`` for ``d < 2^(1/6) sigma``, 0 beyond.
-    ``dist`` (N,) receives each bead's signed distance. Returns the energy; a bead inside
-    (d <= 0) gets zero force here and is caught by the guards.
+    ``U(d) = 4 eps [(sigma/d)^12 - (sigma/d)^6] + eps - c2 k (d - d_c)^2 / 2`` for
+    ``d < d_c = 2^(1/6) sigma``, 0 beyond, with ``k = 72 eps / d_c^2`` the WCA stiffness at
+    the cut-off. ``c2 = 0`` is the plain WCA law, whose stiffness jumps from ``k`` to 0 at
+    the cut-off; ``c2 = 1`` subtracts that curvature so the force has a continuous derivative
+    there (near the cut-off U ~ (d_c - d)^3; still repulsive and monotone on (0, d_c), still
+    diverging as d -> 0). ``dist`` (N,) receives each bead's signed distance. Returns the
+    energy; a bead inside (d <= 0) gets zero force here and is caught by the guards.
     """
     cut = 2.0 ** (1.0 / 6.0) * sigma
+    k2 = c2 * 72.0 * eps / (cut * cut)
     E = 0.0
     for i in range(x.shape[0]):
         d, gx, gy, gz = surface_distance(x[i, 0], x[i, 1], x[i, 2], Rc, H)
@@ -54,8 +59,8 @@ def wca_energy_grad(x, first, Rc, H, sigma, eps, grad, dist):
         if i < first or d >= cut or d <= 0.0:
             continue
         s6 = (sigma / d) ** 6
-        E += 4.0 * eps * (s6 * s6 - s6) + eps
-        dU = 4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / d
+        E += 4.0 * eps * (s6 * s6 - s6) + eps - 0.5 * k2 * (d - cut) ** 2
+        dU = 4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / d - k2 * (d - cut)
         grad[i, 0] += dU * gx
         grad[i, 1] += dU * gy
         grad[i, 2] += dU * gz

@@ -24,9 +24,18 @@ class CappedCylinder:
         WCA energy ``eps`` (core energy units).
     first_bead : int
         beads with a smaller index (the clamp) feel no contact force.
+    potential : {"wca-c2", "wca"}
+        the contact law (:func:`flagwrap.body._kernels.wca_energy_grad`): WCA with its
+        curvature at the cut-off removed (force derivative continuous, default) or plain WCA.
     """
 
-    def __init__(self, radius, length, cutoff, strength, first_bead=2):
+    POTENTIALS = {"wca-c2": 1.0, "wca": 0.0}
+
+    def __init__(self, radius, length, cutoff, strength, first_bead=2, potential="wca-c2"):
+        if potential not in self.POTENTIALS:
+            raise ValueError(f"contact potential must be one of {tuple(self.POTENTIALS)}, got {potential!r}")
+        self.potential = potential
+        self.c2 = self.POTENTIALS[potential]
         self.radius = float(radius)
         self.length = float(length)
         self.cutoff = float(cutoff)
@@ -37,13 +46,13 @@ class CappedCylinder:
     def energy_grad(self, x: np.ndarray, grad: np.ndarray, dist: np.ndarray) -> float:
         """Adds ``dU/dx`` into ``grad`` and writes signed distances into ``dist``."""
         return K.wca_energy_grad(x, self.first_bead, self.radius, self.length, self.sigma,
-                                 self.strength, grad, dist)
+                                 self.strength, self.c2, grad, dist)
 
     def distance(self, x: np.ndarray) -> np.ndarray:
         """Signed distance of each point to the surface (negative inside)."""
         grad = np.zeros_like(x)
         dist = np.empty(len(x))
-        K.wca_energy_grad(x, len(x), self.radius, self.length, self.sigma, 0.0, grad, dist)
+        K.wca_energy_grad(x, len(x), self.radius, self.length, self.sigma, 0.0, 0.0, grad, dist)
         return dist
 
 
@@ -53,6 +62,7 @@ class NoBody:
     radius = 0.0
     length = 0.0
     first_bead = 0
+    c2 = 0.0
 
     def energy_grad(self, x, grad, dist):
         dist[:] = np.inf

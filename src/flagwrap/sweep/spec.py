@@ -71,7 +71,7 @@ BASE_CONFIG = {
     "fluid": {"viscosity": 1.1, "density": 1250.0},
     "body": {"radius_ratio": 0.6, "enabled": True},
     "clamp": {"lead": "kink", "lead_turns": 0.5},
-    "contact": {"range": 1.0, "strength": 1.0},
+    "contact": {"range": 1.0, "strength": 1.0, "potential": "wca-c2"},
     "numerics": {"integrator": "ros34pw2", "hydrodynamics": True, "dt": 1e-3, "tol": 1e-5,
                  "dt_min": 1e-12, "save_every": 0.05, "max_steps": 50_000_000, "threads": 1},
 }
