@@ -129,7 +129,7 @@ def _soa(x, F):
     return xs, ys, zs, fx, fy, fz
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, fastmath=True, error_model="numpy")
 def _rpy_apply_serial(x, a, F, out):
     n = x.shape[0]
     xs, ys, zs, fx, fy, fz = _soa(x, F)
@@ -141,7 +141,7 @@ def _rpy_apply_serial(x, a, F, out):
         out[i, 2] = oz[i]
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, fastmath=True, error_model="numpy", parallel=True)
 def _rpy_apply_parallel(x, a, F, out, nchunk):
     n = x.shape[0]
     xs, ys, zs, fx, fy, fz = _soa(x, F)
