@@ -169,3 +169,29 @@ def scatter_dense(rows, cols, vals, J):
     J[:, :] = 0.0
     for q in range(rows.shape[0]):
         J[rows[q], cols[q]] += vals[q]
+
+
+@nb.njit(cache=True)
+def w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT):
+    """``WT = (I - gamma h Mob J)^T`` straight from the Jacobian triplets.
+
+    ``Mob = blockdiag(Mxx, diag(mt), 0)`` (translations, twists, motor angle). Each triplet
+    ``J[r, c] = v`` adds ``-gamma h Mob[:, r] v`` to column ``c`` of W, i.e. to row ``c`` of
+    ``W^T``, a contiguous write (``Mxx`` is symmetric, so its row ``r`` is its column).
+    O(nnz(J) * 3 nb) instead of the dense product's O(ny^3).
+    """
+    n3 = Mxx.shape[0]
+    ne = mt.shape[0]
+    ny = WT.shape[0]
+    WT[:, :] = 0.0
+    for q in range(rows.shape[0]):
+        r = rows[q]
+        c = cols[q]
+        v = -gamma_h * vals[q]
+        if r < n3:
+            for i in range(n3):
+                WT[c, i] += Mxx[r, i] * v
+        elif r < n3 + ne:
+            WT[c, r] += mt[r - n3] * v
+    for i in range(ny):
+        WT[i, i] += 1.0

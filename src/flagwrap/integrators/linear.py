@@ -38,19 +38,21 @@ class SingularW(Exception):
 
 
 class DenseW:
+    """Dense LU of ``W``, assembled straight from the sparse Jacobian triplets.
+
+    The kernel writes ``W^T`` row by row in C order, which is ``W`` in Fortran order: LAPACK
+    factorises that buffer in place, without the transposing copy a C-ordered ``W`` needs.
+    """
+
     def __init__(self, system, y, base, G0, gamma_h):
-        J = system.force_jacobian(y, base, G0)
+        from flagwrap._system_kernels import w_transpose_dense
+
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0)
         Mxx, mt = system.mobility_blocks(y)
-        # W = I - gamma h Mob J with Mob = blockdiag(Mxx, diag(mt), 0): multiply by blocks only
-        n3, ne = Mxx.shape[0], mt.shape[0]
-        W = np.empty_like(J)
-        np.matmul(Mxx, J[:n3], out=W[:n3])
-        np.multiply(mt[:, None], J[n3:n3 + ne], out=W[n3:n3 + ne])
-        W[n3 + ne:] = 0.0
-        W *= -gamma_h
-        W.flat[:: W.shape[0] + 1] += 1.0
+        WT = np.empty((system.ny, system.ny))
+        w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT)
         try:
-            self.lu = sla.lu_factor(W, overwrite_a=True, check_finite=False)
+            self.lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
         except (ValueError, np.linalg.LinAlgError) as exc:
             raise SingularW(str(exc)) from None
         if not np.all(np.isfinite(self.lu[0])):
