@@ -66,12 +66,15 @@ def _chain(n, seed=3):
     return x, a, rng.standard_normal((n, 3))
 
 
-def test_threaded_direct_product_is_identical():
+def test_threaded_direct_product_agrees_to_rounding():
     from flagwrap.hydrodynamics.mobility import RPYMobility
 
     x, a, F = _chain(700)
-    # each row is summed in the same order, so threads change nothing, bit for bit
-    np.testing.assert_array_equal(RPYMobility(a, threads=2).apply(x, F), RPYMobility(a).apply(x, F))
+    # same pair sums per row; the vectoriser may group them differently in the threaded
+    # build (fast-math reassociation), so rounding-level differences only: 700 terms x 1e-16
+    ref = RPYMobility(a).apply(x, F)
+    np.testing.assert_allclose(RPYMobility(a, threads=2).apply(x, F), ref, rtol=0,
+                               atol=1e-13 * np.abs(ref).max())
 
 
 @pytest.mark.parametrize("eps", [1e-4, 1e-8, 1e-12])

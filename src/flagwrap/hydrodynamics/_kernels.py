@@ -159,8 +159,8 @@ def rpy_apply(x, a, F, out, threads=1):
     """``out = mu_hat F`` matrix-free, O(n^2) time, O(n) memory (x, F, out: (n, 3)).
 
     One compiled call (the structure-of-arrays copies are made inside, so the Python overhead
-    stays ~1 us at N = 61). ``threads > 1`` splits the rows over numba threads (identical
-    result: each row is summed in the same order).
+    stays ~1 us at N = 61). ``threads > 1`` splits the rows over numba threads (the same
+    pair sums per row; equal to rounding, not necessarily bit for bit).
     """
     if threads > 1 and x.shape[0] >= 256:
         _rpy_apply_parallel(x, float(a), F, out, 8 * threads)
