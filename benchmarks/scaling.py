@@ -18,7 +18,7 @@ For N = 61, 250, 1000, 4000, 16000:
   unknowns), ``near`` (near-field W-method, one sparse LU, O(N));
 * peak traced memory (tracemalloc: numpy buffers) of one ``krylov`` step (``near`` at
   N = 16000, where a GMRES step did not finish within 12 min: its iteration count grows with
-  N, ~19 per stage at N = 4000), to show O(N).
+  N, ~18 per stage at N = 4000, from step / product cost), to show O(N).
 
 Prints a table, the crossover N where FMM beats the direct sum (if any), and the steps per
 second of each stepper at N = 1000 (per attempted step; the near W-method also needs ~15x
