@@ -272,6 +272,17 @@ class Simulation:
         except _Stop as stop:
             traj.status = "failed"
             traj.message = str(stop)
+        except KeyboardInterrupt:
+            # keep what was computed, but still stop the caller (a sweep, a notebook): the
+            # exception carries the saved frames (the state mid-step may be half-updated, so
+            # it is not appended; at most save_every of motion is lost)
+            traj.status = "failed"
+            traj.message = f"t/T={t / TWO_PI:.6g}: interrupted (SIGINT / Ctrl-C)"
+            traj.wall_time = wall0 + _time.perf_counter() - start
+            traj.final_frames = base
+            if bar is not None:
+                bar.close()
+            raise RunInterrupted(traj) from None
         finally:
             if bar is not None:
                 bar.close()
@@ -282,6 +293,15 @@ class Simulation:
 
 class _Stop(Exception):
     pass
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C during :meth:`Simulation.run`; ``.trajectory`` holds the frames computed so far
+    (status "failed", message naming the time), e.g. for ``write_run``."""
+
+    def __init__(self, trajectory):
+        super().__init__(trajectory.message)
+        self.trajectory = trajectory
 
 
 def simulate(config, progress: bool = False, resume=None, **kwargs) -> Trajectory:

@@ -142,3 +142,23 @@ def test_resource_guards_name_the_inputs(tmp_path):
                         "-o", str(tmp_path / "huge.nc")], capture_output=True, text=True,
                        timeout=120, env={**os.environ, "FLAGWRAP_MAX_MEMORY": "1G"})
     assert r.returncode == 2 and "numerics.save_every" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_ctrl_c_keeps_a_readable_partial_run_file(tmp_path):
+    import signal
+    import time
+
+    cfgp = tmp_path / "long.toml"
+    cfgp.write_text(tiny_toml(ccw=50, cw=50).replace("tol = 1e-3", "tol = 1e-7"))  # minutes of work
+    out = tmp_path / "long.nc"
+    proc = subprocess.Popen([sys.executable, "-m", "flagwrap.cli.main", "run", str(cfgp), "--quiet",
+                             "-o", str(out)], stderr=subprocess.PIPE, text=True)
+    time.sleep(8)  # start-up + some saved frames
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    assert re.search(r"run stopped: t/T=[0-9.e-]+: interrupted \(SIGINT / Ctrl-C\) \(partial output kept", err), err
+    ds = read_run(out)
+    assert ds.attrs["status"] == "failed" and "interrupted" in ds.attrs["message"]
+    assert len(ds["time"]) >= 1 and np.all(np.isfinite(ds["position"].values))

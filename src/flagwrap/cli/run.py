@@ -90,9 +90,18 @@ def run(args) -> int:
     print(f"flagwrap run {cfg.name}: M = {cfg.machin:.4g}, Re = {cfg.reynolds:.3g}, "
           f"omega/omega_c (scaling) = {cfg.omega_ratio_scaling:.3g}, N = {cfg.filament.n_beads}, "
           f"HI {'on' if cfg.numerics.hydrodynamics else 'off'}", file=sys.stderr)
-    traj = simulate(cfg, progress=not args.quiet, resume=resume, checkpoint_path=ckpt,
-                    checkpoint_every_steps=args.checkpoint_every,
-                    checkpoint_every_seconds=args.checkpoint_seconds)
+    from flagwrap.simulation import RunInterrupted
+
+    try:
+        traj = simulate(cfg, progress=not args.quiet, resume=resume, checkpoint_path=ckpt,
+                        checkpoint_every_steps=args.checkpoint_every,
+                        checkpoint_every_seconds=args.checkpoint_seconds)
+    except RunInterrupted as stop:
+        write_run(stop.trajectory, out)
+        print(f"flagwrap run: run stopped: {stop.trajectory.message} (partial output kept in "
+              f"{out}{'; --resume continues from the last checkpoint' if ckpt is not None else ''})",
+              file=sys.stderr)
+        return 130
     write_run(traj, out)
     if traj.ok and ckpt is not None and ckpt.exists():
         ckpt.unlink()  # the run file now holds everything
