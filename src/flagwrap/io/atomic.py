@@ -3,13 +3,49 @@
 A reader (or a process restarted after ``kill -9``) sees either the old file or the complete
 new one, never a half-written file under the final name. Used for run files, checkpoints,
 sweep rows and tables, and cached critical-search results.
+
+Temporary names are ``.<target>.<host>.<pid>.<random>.tmp``. A writer killed mid-write leaves
+one behind; the next :func:`atomic_write` of the same target removes those of dead processes
+on the same host (never a live writer's, never another host's).
 """
 
 from __future__ import annotations
 
+import glob
 import os
+import socket
 import tempfile
 from pathlib import Path
+
+
+def _host() -> str:
+    return "".join(c if c.isalnum() or c == "-" else "_" for c in socket.gethostname())[:40] or "host"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_temporaries(path) -> list[Path]:
+    """Delete temporaries of ``path`` left by dead writers on this host; return them."""
+    path = Path(path)
+    host = _host()
+    removed = []
+    for tmp in path.parent.glob(f".{glob.escape(path.name)}.{glob.escape(host)}.*.tmp"):
+        pid = tmp.name[len(path.name) + len(host) + 3:].split(".", 1)[0]
+        if pid.isdigit() and int(pid) != os.getpid() and not _alive(int(pid)):
+            try:
+                tmp.unlink()
+                removed.append(tmp)
+            except FileNotFoundError:  # another process cleaned it first
+                pass
+    return removed
 
 
 def fsync_dir(path) -> None:
@@ -34,7 +70,9 @@ def atomic_write(path, write, sync_dir: bool = False) -> Path:
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    remove_stale_temporaries(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{_host()}.{os.getpid()}.", suffix=".tmp",
+                               dir=path.parent)
     os.close(fd)
     try:
         write(Path(tmp))

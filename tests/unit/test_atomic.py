@@ -1,0 +1,44 @@
+"""Atomic writes: complete file or none; temporaries of dead writers are cleaned up."""
+
+import os
+import subprocess
+import sys
+
+from flagwrap.io.atomic import _host, atomic_write, remove_stale_temporaries
+
+
+def _dead_pid():
+    p = subprocess.Popen([sys.executable, "-c", "pass"])
+    p.wait()
+    return p.pid
+
+
+def test_stale_temporaries_of_dead_writers_are_removed_live_ones_kept(tmp_path):
+    target = tmp_path / "row.json"
+    host = _host()
+    dead = tmp_path / f".row.json.{host}.{_dead_pid()}.abc123.tmp"
+    live = tmp_path / f".row.json.{host}.{os.getppid()}.def456.tmp"  # the test runner's parent
+    other_host = tmp_path / f".row.json.otherhost.{_dead_pid()}.ghi789.tmp"
+    other_target = tmp_path / f".row2.json.{host}.{_dead_pid()}.jkl012.tmp"
+    for f in (dead, live, other_host, other_target):
+        f.write_text("partial")
+    atomic_write(target, lambda tmp: tmp.write_text('{"ok": 1}'))
+    assert target.read_text() == '{"ok": 1}'
+    assert not dead.exists()
+    assert live.exists() and other_host.exists() and other_target.exists()
+    assert remove_stale_temporaries(target) == []
+
+
+def test_failed_write_leaves_neither_target_nor_temporary(tmp_path):
+    target = tmp_path / "run.nc"
+
+    def boom(tmp):
+        tmp.write_text("half")
+        raise RuntimeError("disk full")
+
+    try:
+        atomic_write(target, boom)
+    except RuntimeError:
+        pass
+    assert not target.exists()
+    assert list(tmp_path.iterdir()) == []
