@@ -42,3 +42,19 @@ def test_failed_write_leaves_neither_target_nor_temporary(tmp_path):
         pass
     assert not target.exists()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_sweep_store_clean_spares_live_writers(tmp_path):
+    from flagwrap.sweep.store import SweepStore
+
+    store = SweepStore(tmp_path)
+    store.rows.mkdir(parents=True)
+    host = _host()
+    dead = store.rows / f".k1.json.{host}.{_dead_pid()}.aaaa1111.tmp"
+    legacy = store.rows / ".k2.json.bbbb2222.tmp"  # written before names carried host/pid
+    live = store.rows / f".k3.json.{host}.{os.getppid()}.cccc3333.tmp"
+    remote = store.rows / f".k4.json.otherhost.{_dead_pid()}.dddd4444.tmp"
+    for f in (dead, legacy, live, remote):
+        f.write_text("partial")
+    assert store.clean() == 2
+    assert not dead.exists() and not legacy.exists() and live.exists() and remote.exists()

@@ -32,34 +32,34 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def remove_stale_temporaries(path) -> list[Path]:
-    """Delete temporaries of ``path`` left by dead writers on this host; return them."""
-    path = Path(path)
+def _is_stale(tmp: Path, host: str) -> bool:
+    """A temporary ``.<target>.<host>.<pid>.<random>.tmp`` whose writer is gone: same host and
+    a dead pid, or a name without host/pid (written before temporaries carried them)."""
+    parts = tmp.name[1:-len(".tmp")].rsplit(".", 3)
+    if len(parts) == 4 and parts[2].isdigit():
+        pid = int(parts[2])
+        return parts[1] == host and pid != os.getpid() and not _alive(pid)
+    return True
+
+
+def remove_stale_temporaries(path=None, folder=None) -> list[Path]:
+    """Delete the temporaries left by dead writers on this host, of the target ``path`` or of
+    every target in ``folder``; never a live writer's or another host's. Returns them."""
     host = _host()
+    if path is not None:
+        path = Path(path)
+        candidates = path.parent.glob(f".{glob.escape(path.name)}.{glob.escape(host)}.*.tmp")
+    else:
+        candidates = Path(folder).glob(".*.tmp")
     removed = []
-    for tmp in path.parent.glob(f".{glob.escape(path.name)}.{glob.escape(host)}.*.tmp"):
-        pid = tmp.name[len(path.name) + len(host) + 3:].split(".", 1)[0]
-        if pid.isdigit() and int(pid) != os.getpid() and not _alive(int(pid)):
+    for tmp in candidates:
+        if _is_stale(tmp, host):
             try:
                 tmp.unlink()
                 removed.append(tmp)
             except FileNotFoundError:  # another process cleaned it first
                 pass
     return removed
-
-
-def fsync_dir(path) -> None:
-    """Flush a directory entry (makes a completed rename durable on POSIX)."""
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:  # pragma: no cover - platforms without directory fds
-        return
-    try:
-        os.fsync(fd)
-    except OSError:  # pragma: no cover
-        pass
-    finally:
-        os.close(fd)
 
 
 def atomic_write(path, write, sync_dir: bool = False) -> Path:

@@ -21,7 +21,7 @@ import json
 import math
 from pathlib import Path
 
-from flagwrap.io.atomic import atomic_write
+from flagwrap.io.atomic import atomic_write, remove_stale_temporaries
 
 #: columns that differ between two runs of the same case (timing, host); excluded from
 #: :meth:`SweepStore.table` with ``volatile=False``
@@ -86,14 +86,10 @@ class SweepStore:
         return write_json_atomic(jsonable(result), self.boundary / f"{gkey}.json")
 
     def clean(self) -> int:
-        """Remove temporary files left by a killed writer; returns how many."""
-        n = 0
-        for d in (self.runs, self.rows, self.boundary, self.critical):
-            if d.is_dir():
-                for p in d.glob(".*.tmp"):
-                    p.unlink(missing_ok=True)
-                    n += 1
-        return n
+        """Remove temporary files left by killed writers (not a live worker's: another sweep
+        process or a cluster worker may be writing here); returns how many."""
+        return sum(len(remove_stale_temporaries(folder=d))
+                   for d in (self.runs, self.rows, self.boundary, self.critical) if d.is_dir())
 
     def iter_rows(self):
         """Every complete row (sorted by key)."""
