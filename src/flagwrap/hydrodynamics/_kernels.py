@@ -129,16 +129,21 @@ def _soa(x, F):
     return xs, ys, zs, fx, fy, fz
 
 
+@nb.njit(cache=True)
+def _aos(ox, oy, oz, out):
+    for i in range(ox.shape[0]):
+        out[i, 0] = ox[i]
+        out[i, 1] = oy[i]
+        out[i, 2] = oz[i]
+
+
 @nb.njit(cache=True, fastmath=True, error_model="numpy")
 def _rpy_apply_serial(x, a, F, out):
     n = x.shape[0]
     xs, ys, zs, fx, fy, fz = _soa(x, F)
     ox, oy, oz = np.empty(n), np.empty(n), np.empty(n)
     _rows_serial(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, 0, n)
-    for i in range(n):
-        out[i, 0] = ox[i]
-        out[i, 1] = oy[i]
-        out[i, 2] = oz[i]
+    _aos(ox, oy, oz, out)
 
 
 @nb.njit(cache=True, fastmath=True, error_model="numpy", parallel=True)
@@ -149,10 +154,7 @@ def _rpy_apply_parallel(x, a, F, out, nchunk):
     for c in nb.prange(nchunk):
         _rows_serial(xs, ys, zs, a, fx, fy, fz, ox, oy, oz,
                      (c * n) // nchunk, ((c + 1) * n) // nchunk)
-    for i in range(n):
-        out[i, 0] = ox[i]
-        out[i, 1] = oy[i]
-        out[i, 2] = oz[i]
+    _aos(ox, oy, oz, out)
 
 
 def rpy_apply(x, a, F, out, threads=1):
