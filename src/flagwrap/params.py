@@ -340,8 +340,9 @@ class Contact:
     its curvature at the cut-off subtracted, so the force has a continuous derivative there;
     "wca" is the plain WCA law, whose stiffness jumps at the cut-off. The jump made the
     error-controlled stepper reject every other step while beads slid over the body (Fig. 5
-    case psi 45, n 2, M 5388, 5 + 7 turns: 20606 steps + 11478 rejections, 129 s, against
-    6034 + 158, 25 s with "wca-c2"; free end equal to 1e-5 L; docs/model.md).
+    case psi 45, n 2, M 5388, 5 + 7 turns, ``python studies/contact_law.py``: 20080 steps +
+    11066 rejections, 53 s, against 6032 + 152, 12 s with "wca-c2"; free ends within
+    1.5e-5 L; docs/model.md).
     """
 
     range: float = 1.0
