@@ -62,6 +62,20 @@ def remove_stale_temporaries(path=None, folder=None) -> list[Path]:
     return removed
 
 
+def fsync_dir(path) -> None:
+    """Flush a directory entry (makes a completed rename durable on POSIX)."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:  # pragma: no cover - platforms without directory fds
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # pragma: no cover
+        pass
+    finally:
+        os.close(fd)
+
+
 def atomic_write(path, write, sync_dir: bool = False) -> Path:
     """Create ``path`` atomically; ``write(tmp)`` must write the whole file at ``tmp`` (a Path).
 
