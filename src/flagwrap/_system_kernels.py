@@ -165,6 +165,45 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
 
 
 @nb.njit(cache=True)
+def unit_tangents(x, t):
+    """``t[j] = (x[j+1] - x[j]) / |x[j+1] - x[j]|`` (the next base's tangents)."""
+    for j in range(x.shape[0] - 1):
+        e0 = x[j + 1, 0] - x[j, 0]
+        e1 = x[j + 1, 1] - x[j, 1]
+        e2 = x[j + 1, 2] - x[j, 2]
+        inv = 1.0 / math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        t[j, 0] = e0 * inv
+        t[j, 1] = e1 * inv
+        t[j, 2] = e2 * inv
+
+
+@nb.njit(cache=True)
+def band_from_triplets(rows, cols, vals, d, gamma_h, inv, kl, ku, n, ab, w):
+    """LAPACK band storage of ``W' = I - gamma h diag(d) J`` (beads and twists, RCM order
+    ``inv``) and the motor-angle column ``w`` (see :class:`~flagwrap.integrators.linear.BandedW`).
+
+    ``ab`` (2 kl + ku + 1, n), Fortran order, zeroed here; ``ab[kl + ku + i - j, j] = W'[i, j]``;
+    duplicate triplets add.
+    """
+    ab[:, :] = 0.0
+    w[:] = 0.0
+    for q in range(rows.shape[0]):
+        r = rows[q]
+        if r >= n:
+            continue
+        c = cols[q]
+        v = -gamma_h * d[r] * vals[q]
+        if c == n:
+            w[r] += v
+        else:
+            i = inv[r]
+            j = inv[c]
+            ab[kl + ku + i - j, j] += v
+    for j in range(n):
+        ab[kl + ku, j] += 1.0
+
+
+@nb.njit(cache=True)
 def scatter_dense(rows, cols, vals, J):
     J[:, :] = 0.0
     for q in range(rows.shape[0]):

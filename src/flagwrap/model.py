@@ -161,8 +161,8 @@ class RodSystem:
         dist = np.empty(N)
         E, Ec = SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base),
                                       G, x, theta, gx, gth, d1, rt, dist)
-        e = np.diff(x, axis=0)
-        t = e / np.sqrt(np.einsum("ij,ij->i", e, e))[:, None]
+        t = np.empty((N - 1, 3))
+        SK.unit_tangents(x, t)
         return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist)
 
     def apply_mobility(self, y: np.ndarray, G: np.ndarray) -> np.ndarray:

@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from flagwrap.motor.protocol import Schedule
 from flagwrap.params import Numerics, Phase
@@ -46,3 +48,17 @@ def test_ccw_keeps_left_handed_helix_and_cw_unwinds_it_near_motor():
     assert rest < 0 and ccw < 0 and cw < 0  # still left-handed on average (no buckling here)
     assert ccw < rest * 1.05  # overwound by more than 5 %
     assert cw > rest * 0.95  # unwound by more than 5 %
+
+
+@given(phi=st.floats(-50.0, 50.0),
+       axis=st.tuples(*[st.floats(-1.0, 1.0)] * 3).filter(lambda a: np.linalg.norm(a) > 0.1))
+@settings(max_examples=50, deadline=None)
+def test_clamp_positions_are_rotations_about_the_motor_axis(phi, axis):
+    """The precomputed Rodrigues split equals the rotation matrix (an independent formula)."""
+    from flagwrap.geometry.frames import rotation_matrix
+    from flagwrap.motor.clamp import AxialClamp
+
+    x0 = np.array([[0.1, -0.2, 0.3], [0.4, 0.5, -0.6], [1.0, 1.0, 1.0]])
+    clamp = AxialClamp(x0, np.zeros(2), axis=axis)
+    Rm = rotation_matrix(np.asarray(axis), phi)
+    assert np.allclose(clamp.positions(phi), x0[:2] @ Rm.T, atol=1e-13)

@@ -139,19 +139,18 @@ def _band_structure(system, rows, cols):
     """Reverse Cuthill-McKee order of the Jacobian pattern without the motor angle, and the
     bandwidths (kl, ku) it gives.
 
-    The pattern is fixed for a system (coloured differences, same triplets every call), so it
-    is computed once and cached on the system.
+    The pattern is fixed for a system (coloured differences and the analytic stretching block
+    give the same triplets every call; only the motor-angle column's non-zeros vary and it is
+    not part of the band), so it is computed once and cached on the system.
     """
+    cached = getattr(system, "_band_cache", None)
+    if cached is not None:
+        return cached
     import scipy.sparse as sp
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
     n = system.ny - 1
     keep = (rows < n) & (cols < n)
-    # the motor-angle column's non-zeros vary between calls; the rest of the pattern does not
-    nkeep = int(keep.sum())
-    cached = getattr(system, "_band_cache", None)
-    if cached is not None and cached[0] == nkeep:
-        return cached[1:]
     A = sp.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(n, n))
     A = A + A.T + sp.identity(n, format="csr")
     perm = np.asarray(reverse_cuthill_mckee(A.tocsr(), symmetric_mode=True), dtype=np.int64)
@@ -160,8 +159,8 @@ def _band_structure(system, rows, cols):
     r, c = inv[rows[keep]], inv[cols[keep]]
     kl = int(max(0, (r - c).max()))
     ku = int(max(0, (c - r).max()))
-    system._band_cache = (nkeep, perm, inv, kl, ku)
-    return perm, inv, kl, ku
+    system._band_cache = (perm, inv, kl, ku)
+    return system._band_cache
 
 
 class BandedW:
@@ -178,22 +177,17 @@ class BandedW:
     def __init__(self, system, y, base, G0, gamma_h):
         from scipy.linalg.lapack import dgbtrf
 
+        from flagwrap._system_kernels import band_from_triplets
+
         if system.mobility.long_range:
             raise ValueError("BandedW needs a local mobility (numerics.hydrodynamics = false)")
         rows, cols, vals = system.force_jacobian_coo(y, base, G0)
         perm, inv, kl, ku = _band_structure(system, rows, cols)
         n = system.ny - 1
-        d = system.local_mobility_diagonal()
-        v = -gamma_h * d[rows] * vals
-        last = cols == n
-        self.w = np.bincount(rows[last], weights=v[last], minlength=n + 1)[:n]
-        keep = (rows < n) & ~last
-        r, c = inv[rows[keep]], inv[cols[keep]]
-        ldab = 2 * kl + ku + 1
-        # LAPACK band storage: ab[kl + ku + i - j, j] = W[i, j]; duplicates add
-        ab = np.bincount((kl + ku + r - c) * n + c, weights=v[keep],
-                         minlength=ldab * n).reshape(ldab, n)
-        ab[kl + ku] += 1.0
+        ab = np.empty((2 * kl + ku + 1, n), order="F")
+        self.w = np.empty(n)
+        band_from_triplets(rows, cols, vals, system.local_mobility_diagonal(), gamma_h, inv,
+                           kl, ku, n, ab, self.w)
         lu, piv, info = dgbtrf(ab, kl, ku, overwrite_ab=1)
         if info != 0 or not np.all(np.isfinite(lu)):
             raise SingularW(f"banded LU failed (info {info})")

@@ -7,9 +7,10 @@ would be another class with the same methods.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from flagwrap.geometry.frames import rotation_matrix
 
 
 class AxialClamp:
@@ -33,10 +34,15 @@ class AxialClamp:
         t0 = x0[1] - x0[0]
         t0 = t0 / np.linalg.norm(t0)
         self.twist_rate = float(np.dot(t0, self.axis))
+        # Rodrigues split once: x(phi) = par + cos(phi) perp + sin(phi) axis x perp (called at
+        # every force evaluation, where building a rotation matrix cost more than the forces)
+        par = np.outer(self.x_ref @ self.axis, self.axis)
+        self._par = par
+        self._perp = self.x_ref - par
+        self._cross = np.cross(self.axis, self._perp)
 
     def positions(self, phi: float) -> np.ndarray:
-        Rm = rotation_matrix(self.axis, phi)
-        return self.x_ref @ Rm.T
+        return self._par + math.cos(phi) * self._perp + math.sin(phi) * self._cross
 
     def theta(self, phi: float) -> np.ndarray:
         return self.theta_ref + self.twist_rate * phi
