@@ -178,13 +178,18 @@ def unit_tangents(x, t):
 
 
 @nb.njit(cache=True)
-def band_from_triplets(rows, cols, vals, d, gamma_h, inv, kl, ku, n, ab, w):
-    """LAPACK band storage of ``W' = I - gamma h diag(d) J`` (beads and twists, RCM order
-    ``inv``) and the motor-angle column ``w`` (see :class:`~flagwrap.integrators.linear.BandedW`).
+def band_from_triplets(rows, cols, vals, Mb, wd, mt, gamma_h, inv, kl, ku, n, ab, w):
+    """LAPACK band storage of ``W' = I - gamma h Mob_near J`` (beads and twists, in the
+    reverse-Cuthill-McKee order ``inv``) and the motor-angle column ``w`` (see
+    :class:`~flagwrap.integrators.linear.BandedW`).
 
-    ``ab`` (2 kl + ku + 1, n), Fortran order, zeroed here; ``ab[kl + ku + i - j, j] = W'[i, j]``;
-    duplicate triplets add.
+    ``Mob_near``: translational 3x3 blocks ``Mb[i, wd + k] = Mob_{i, i+k}`` for |k| <= wd
+    (``wd = 0``: the local mobility) and the twist diagonal ``mt``. Each triplet ``J[r, c] = v``
+    adds ``-gamma h Mob[:, r] v`` to column ``c``; ``ab`` (2 kl + ku + 1, n), Fortran order,
+    is zeroed here, ``ab[kl + ku + i - j, j] = W'[i, j]``.
     """
+    nb3 = Mb.shape[0] * 3
+    nbd = Mb.shape[0]
     ab[:, :] = 0.0
     w[:] = 0.0
     for q in range(rows.shape[0]):
@@ -192,13 +197,27 @@ def band_from_triplets(rows, cols, vals, d, gamma_h, inv, kl, ku, n, ab, w):
         if r >= n:
             continue
         c = cols[q]
-        v = -gamma_h * d[r] * vals[q]
-        if c == n:
-            w[r] += v
+        v = -gamma_h * vals[q]
+        if r < nb3:
+            p = r // 3
+            k = r - 3 * p
+            for dp in range(-wd, wd + 1):
+                ib = p + dp
+                if ib < 0 or ib >= nbd:
+                    continue
+                for m in range(3):
+                    i = 3 * ib + m
+                    val = Mb[ib, wd - dp, m, k] * v
+                    if c == n:
+                        w[i] += val
+                    else:
+                        ab[kl + ku + inv[i] - inv[c], inv[c]] += val
         else:
-            i = inv[r]
-            j = inv[c]
-            ab[kl + ku + i - j, j] += v
+            val = mt[r - nb3] * v
+            if c == n:
+                w[r] += val
+            else:
+                ab[kl + ku + inv[r] - inv[c], inv[c]] += val
     for j in range(n):
         ab[kl + ku, j] += 1.0
 

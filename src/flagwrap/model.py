@@ -188,20 +188,14 @@ class RodSystem:
         d[self.sl_th] = 1.0 / (self.machin * self.rot_drag[self.ec:])
         return d
 
-    def near_field_mobility(self, y: np.ndarray, width: int | None = None):
-        """Sparse ``Mob`` restricted to bead pairs within ``width`` along the chain (core units).
-
-        Default width covers the overlapping neighbours (``4a/b`` beads) plus 4: the part of
-        the hydrodynamics that acts on the stiff, short-wavelength modes.
-        """
-        import scipy.sparse as sp
-
-        if width is None:
-            width = int(math.ceil(4 * self.radius / self.bond)) + 4
+    def near_field_blocks(self, y: np.ndarray, width: int):
+        """Near-field ``Mob`` (core units) for banded solvers: translational 3x3 blocks
+        ``(nb, 2 width + 1, 3, 3)`` between beads at most ``width`` apart along the chain
+        (only the self blocks for a local mobility) and the twist diagonal ``(ne,)``."""
         x, _, _ = self.unpack(y)
-        Mx = self.mobility.near_field(x[self.nc:], width) / self.machin
-        d = self.local_mobility_diagonal()
-        return sp.block_diag((Mx, sp.diags(d[3 * self.nb:])), format="csr")
+        Mb = self.mobility.near_field_blocks(x[self.nc:], width)
+        Mb /= self.machin
+        return Mb, 1.0 / (self.machin * self.rot_drag[self.ec:])
 
     def mobility_blocks(self, y: np.ndarray):
         """``Mob`` as its two non-zero blocks: dense translational (3nb, 3nb), twist diagonal (ne,)."""

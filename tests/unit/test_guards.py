@@ -151,9 +151,16 @@ def test_ctrl_c_keeps_a_readable_partial_run_file(tmp_path):
     cfgp = tmp_path / "long.toml"
     cfgp.write_text(tiny_toml(ccw=50, cw=50).replace("tol = 1e-3", "tol = 1e-7"))  # minutes of work
     out = tmp_path / "long.nc"
+    ckpt = tmp_path / "long.ckpt.h5"
     proc = subprocess.Popen([sys.executable, "-m", "flagwrap.cli.main", "run", str(cfgp), "--quiet",
-                             "-o", str(out)], stderr=subprocess.PIPE, text=True)
-    time.sleep(8)  # start-up + some saved frames
+                             "-o", str(out), "--checkpoint", str(ckpt), "--checkpoint-every", "50"],
+                            stderr=subprocess.PIPE, text=True)
+    # wait until the time loop runs (a checkpoint exists), however long imports and a cold
+    # numba cache take, then let it save a few frames
+    t0 = time.monotonic()
+    while not ckpt.exists() and proc.poll() is None and time.monotonic() - t0 < 300:
+        time.sleep(0.2)
+    time.sleep(2)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err

@@ -171,29 +171,22 @@ def rpy_apply(x, a, F, out, threads=1):
 
 
 @nb.njit(cache=True)
-def rpy_band_coo(x, a, w):
-    """RPY blocks for |i - j| <= w as COO triplets (near-field part, for preconditioners)."""
+def rpy_band_blocks(x, a, w, out):
+    """``out[i, w + k] = mu_hat_{i, i+k}`` (3x3) for |k| <= w (zero past the chain ends).
+
+    The near-field blocks a banded preconditioner assembles ``W`` from; ``w = 0`` is the
+    self mobility alone.
+    """
     n = x.shape[0]
-    nnz = 0
-    for i in range(n):
-        lo = max(0, i - w)
-        hi = min(n - 1, i + w)
-        nnz += 9 * (hi - lo + 1)
-    rows = np.empty(nnz, np.int64)
-    cols = np.empty(nnz, np.int64)
-    vals = np.empty(nnz)
-    k = 0
     s = 1.0 / (6.0 * math.pi * a)
+    out[:, :, :, :] = 0.0
     for i in range(n):
-        for j in range(max(0, i - w), min(n - 1, i + w) + 1):
-            if i == j:
-                for p in range(3):
-                    for q in range(3):
-                        rows[k] = 3 * i + p
-                        cols[k] = 3 * j + q
-                        vals[k] = s if p == q else 0.0
-                        k += 1
-                continue
+        for p in range(3):
+            out[i, w, p, p] = s
+        for k in range(1, w + 1):
+            j = i + k
+            if j >= n:
+                break
             d0 = x[i, 0] - x[j, 0]
             d1 = x[i, 1] - x[j, 1]
             d2 = x[i, 2] - x[j, 2]
@@ -202,11 +195,9 @@ def rpy_band_coo(x, a, w):
             u = (d0 / r, d1 / r, d2 / r) if r > 0.0 else (0.0, 0.0, 0.0)
             for p in range(3):
                 for q in range(3):
-                    rows[k] = 3 * i + p
-                    cols[k] = 3 * j + q
-                    vals[k] = g * u[p] * u[q] + (f if p == q else 0.0)
-                    k += 1
-    return rows, cols, vals
+                    v = g * u[p] * u[q] + (f if p == q else 0.0)
+                    out[i, w + k, p, q] = v
+                    out[j, w - k, q, p] = v
 
 
 @nb.njit(cache=True)

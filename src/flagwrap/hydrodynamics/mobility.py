@@ -20,7 +20,7 @@ A mobility maps forces on the hydrodynamically active beads to their velocities,
   CPU it was slower than the vectorised direct sum at every N up to 16000
   (benchmarks/scaling.py prints both).
 
-The integrators only see ``apply``/``matrix``/``near_field``, so a backend swaps without
+The integrators only see ``apply``/``matrix``/``near_field_blocks``, so a backend swaps without
 touching them.
 """
 
@@ -45,15 +45,18 @@ class Mobility:
     def matrix(self, x: np.ndarray) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
 
-    def near_field(self, x: np.ndarray, width: int):
-        """Sparse (CSR) part of the mobility between beads at most ``width`` apart."""
-        import scipy.sparse as sp
-
-        n = 3 * len(x)
-        if not self.long_range:
-            return sp.identity(n, format="csr") * self.self_mobility
-        r, c, v = K.rpy_band_coo(np.ascontiguousarray(x, dtype=np.float64), self.radius, int(width))
-        return sp.csr_matrix((v, (r, c)), shape=(n, n))
+    def near_field_blocks(self, x: np.ndarray, width: int) -> np.ndarray:
+        """Mobility between beads at most ``width`` apart along the chain, as dense 3x3
+        blocks ``out[i, width + k] = mu_hat_{i, i+k}``, shape (n, 2 width + 1, 3, 3), for
+        banded preconditioners; a local mobility has only its self blocks."""
+        width = int(width) if self.long_range else 0
+        out = np.empty((len(x), 2 * width + 1, 3, 3))
+        if self.long_range:
+            K.rpy_band_blocks(np.ascontiguousarray(x, dtype=np.float64), self.radius, width, out)
+        else:
+            out[:] = 0.0
+            out[:, 0] = np.eye(3) * self.self_mobility
+        return out
 
 
 class RPYMobility(Mobility):

@@ -3,16 +3,16 @@
 * :class:`DenseW` assembles ``W`` (ny x ny) and LU-factorises it once per step: fastest for
   short chains (N ~ 60 -> ny ~ 240), O(N^3) time and O(N^2) memory.
 * :class:`KrylovW` never forms a dense matrix: ``J`` is sparse (banded, from the coloured
-  Jacobian), ``Mob`` is applied matrix-free (O(N^2) RPY product, O(N) memory) and GMRES is
-  preconditioned by the near-field operator ``I - gamma h Mob_near J`` (sparse LU). It solves
-  to a relative residual ``rtol = 1e-3``: the stage increments are ~|dy| per step ~1e-3 L, so
-  the solve error (~1e-6 L) stays below the step tolerance 1e-5 L. Measured on the long
-  chain (benchmarks/scaling.py's, 0.01 turn): the same accepted steps as the exact LU (N =
-  500: 60 vs 59), free end equal to 1e-5 L, 6-8 GMRES iterations per stage (~150 at rtol
-  1e-10). The preconditioner keeps the near-field hydrodynamics (bead pairs within
-  ``4a/b + 4`` along the chain), which governs the stiff short-wavelength modes.
+  Jacobian), ``Mob`` is applied matrix-free (O(N^2) RPY product, O(N) memory) and GCR with
+  subspace recycling across the four stages is right-preconditioned by the banded LU of the
+  near-field ``I - gamma h Mob_near J``. It solves to a relative residual ``rtol = 1e-3``:
+  the stage increments are ~|dy| per step ~1e-3 L, so the solve error (~1e-6 L) stays below
+  the step tolerance 1e-5 L. Measured (long chain of benchmarks/scaling.py): N = 61, 0.5 turn
+  from rest, free end 7.0e-4 L from a tol = 1e-7 reference against 7.3e-4 L for the exact LU
+  (the time-stepping error dominates; rtol 1e-4 and 1e-5 give 7.5e-4 and 7.3e-4); 2.6 RPY
+  products per stage at N = 1000 (scipy's restarted GMRES needed ~8-13).
 * :class:`NearW` drops the far field from ``W`` altogether (a W-method keeps its order for
-  any ``W``): one sparse LU and one full ``Mob F`` per stage. Its error estimate is looser and
+  any ``W``): one banded LU and one full ``Mob F`` per stage. Its error estimate is looser and
   the long-wavelength stretching modes, whose relaxation the far field speeds up, limit its
   step: ~15x the steps of the exact ``W`` (N = 500: 846 steps + 292 rejections vs 59 + 18),
   so it lost to KrylovW everywhere measured; kept as an option.
@@ -20,17 +20,20 @@
   mobility: banded, O(N).
 
 ``make_w(kind, ...)`` picks one; ``"auto"``: banded with HI off, dense up to
-``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover is measured (0.01-0.5 turn of the
-long chain, same steps both ways): N = 61 dense 2.0 s vs krylov 5.1 s; N = 120 2.7 vs 2.5 s;
-N = 250 2.2 vs 1.1 s; N = 500 50 vs 6.0 s (docs/numerics.md).
+``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover is measured (long chain of
+benchmarks/scaling.py, 0.3-0.5 turn from rest, same steps both ways, one core): N = 61
+(237 unknowns) dense 1.59 vs krylov 1.73 ms per step; N = 80 (317) 2.24 vs 1.91; N = 95
+3.56 vs 1.96; N = 120 4.69 vs 2.61 (docs/numerics.md).
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.linalg as sla
 
-AUTO_CROSSOVER_NY = 500
+AUTO_CROSSOVER_NY = 300
 
 
 class SingularW(Exception):
@@ -62,54 +65,86 @@ class DenseW:
         return sla.lu_solve(self.lu, rhs, check_finite=False)
 
 
-def _near_field_lu(system, y, J, gamma_h, width=None):
-    """Sparse LU of the near-field ``I - gamma h Mob_near J`` (``J`` sparse): the GMRES
-    preconditioner of :class:`KrylovW` and the whole ``W`` of :class:`NearW`."""
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spla
-
-    Mnear = system.near_field_mobility(y, width)
-    try:
-        return spla.splu(sp.identity(system.ny, format="csc") - gamma_h * (Mnear @ J).tocsc())
-    except RuntimeError as exc:
-        raise SingularW(str(exc)) from None
-
-
 class KrylovW:
-    """Matrix-free ``W`` with a sparse near-field preconditioner (GMRES, relative tol ``rtol``)."""
+    """Matrix-free ``W`` solved by preconditioned GCR with subspace recycling.
 
-    def __init__(self, system, y, base, G0, gamma_h, rtol=1e-3, maxiter=200):
-        import scipy.sparse.linalg as spla
+    ``W v = v - gamma h Mob (J v)``: ``J`` sparse (coloured Jacobian), ``Mob`` applied
+    matrix-free (O(N^2) direct sum or any backend; O(N) memory). Right preconditioner: the
+    banded LU of the near-field ``W`` (:class:`BandedW`, RPY blocks of beads within
+    ``width`` along the chain). GCR (Eisenstat, Elman & Schultz 1983) keeps every search
+    direction ``z`` with ``W z`` orthonormalised, so the four stages of a Rosenbrock step,
+    which share ``W``, reuse the earlier stages' directions: each solve first projects its
+    right-hand side on them (no product needed) and then iterates only on what is left
+    (recycling, as in GCRO: Parks et al., SIAM J. Sci. Comput. 28, 1651, 2006). Stops at
+    relative residual ``rtol`` (true residual, updated exactly in exact arithmetic); ``rtol =
+    1e-3`` suffices because the stage increments are ~1e-3 L per step, so the solve error
+    (~1e-6 L) stays below the step tolerance 1e-5 L. Measured at N = 1000 (long chain):
+    2.6 products per stage instead of 8 with scipy's restarted GMRES (docs/numerics.md).
+    """
 
+    max_vectors = 64
+
+    def __init__(self, system, y, base, G0, gamma_h, rtol=1e-3, maxiter=200, width=1):
         self.system = system
         self.y = y
         self.gh = gamma_h
         self.rtol = rtol
         self.maxiter = maxiter
-        self.J = system.force_jacobian_sparse(y, base, G0)
-        self.P = _near_field_lu(system, y, self.J, gamma_h)
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0)
+        import scipy.sparse as sp
+
+        self.J = sp.csr_matrix((vals, (rows, cols)), shape=(system.ny, system.ny))
+        self.P = BandedW(system, y, base, G0, gamma_h, width=width,
+                         triplets=(rows, cols, vals))
         n = system.ny
-        self.A = spla.LinearOperator((n, n), matvec=self._matvec, dtype=float)
-        self.M = spla.LinearOperator((n, n), matvec=self.P.solve, dtype=float)
+        self.Z = np.empty((self.max_vectors, n))
+        self.C = np.empty((self.max_vectors, n))
+        self.k = 0
         self.iterations = 0
 
-    def _matvec(self, v):
+    def matvec(self, v):
         return v - self.gh * self.system.apply_mobility(self.y, self.J @ v)
 
     def solve(self, rhs):
-        import scipy.sparse.linalg as spla
-
-        count = [0]
-
-        def cb(_):
-            count[0] += 1
-
-        u, info = spla.gmres(self.A, rhs, M=self.M, rtol=self.rtol, atol=0.0, restart=50,
-                             maxiter=self.maxiter, callback=cb, callback_type="pr_norm")
-        self.iterations += count[0]
-        if info != 0:
-            raise SingularW(f"GMRES did not converge ({info})")
-        return u
+        bn = float(np.linalg.norm(rhs))
+        x = np.zeros_like(rhs)
+        if bn == 0.0:
+            return x
+        r = np.array(rhs, dtype=float)
+        k = self.k
+        if k:  # minimal-residual start in the recycled space (C orthonormal)
+            a = self.C[:k] @ r
+            x += a @ self.Z[:k]
+            r -= a @ self.C[:k]
+        it = 0
+        while float(np.linalg.norm(r)) > self.rtol * bn:
+            if it >= self.maxiter:
+                raise SingularW(f"GCR: residual {np.linalg.norm(r) / bn:.1e} after {it} "
+                                f"iterations (rtol {self.rtol})")
+            if self.k == self.max_vectors:  # storage full: restart from the current x
+                self.k = 0
+            z = self.P.solve(r)
+            c = self.matvec(z)
+            it += 1
+            k = self.k
+            for _ in range(2):  # classical Gram-Schmidt, twice (orthogonal to rounding)
+                if k:
+                    g = self.C[:k] @ c
+                    c -= g @ self.C[:k]
+                    z -= g @ self.Z[:k]
+            nc = float(np.linalg.norm(c))
+            if not np.isfinite(nc) or nc == 0.0:
+                raise SingularW("GCR breakdown")
+            c /= nc
+            z /= nc
+            a = float(c @ r)
+            x += a * z
+            r -= a * c
+            self.C[k] = c
+            self.Z[k] = z
+            self.k = k + 1
+        self.iterations += it
+        return x
 
 
 class NearW:
@@ -119,14 +154,15 @@ class NearW:
     2005), so ``W`` may drop the far-field hydrodynamics while every stage still sees the
     full mobility through ``f``. The far field is not negligible on the long-wavelength
     stretching modes, though, so the step controller takes ~15x the steps of the exact ``W``
-    (module docstring). Cost per step: one sparse banded LU, O(N) in time and memory, plus one
+    (module docstring). Cost per step: one banded LU, O(N) in time and memory, plus one
     full ``Mob F`` per stage. ``width`` (beads along the chain kept in ``Mob_near``) defaults
-    to :meth:`RodSystem.near_field_mobility`'s overlap range + 4.
+    to the overlapping neighbours (``4a/b`` beads) + 4.
     """
 
     def __init__(self, system, y, base, G0, gamma_h, width=None):
-        self.lu = _near_field_lu(system, y, system.force_jacobian_sparse(y, base, G0), gamma_h,
-                                 width)
+        if width is None:
+            width = int(math.ceil(4 * system.radius / system.bond)) + 4
+        self.lu = BandedW(system, y, base, G0, gamma_h, width=width)
 
     def solve(self, rhs):
         u = self.lu.solve(rhs)
@@ -135,59 +171,69 @@ class NearW:
         return u
 
 
-def _band_structure(system, rows, cols):
-    """Reverse Cuthill-McKee order of the Jacobian pattern without the motor angle, and the
-    bandwidths (kl, ku) it gives.
+def _band_structure(system, rows, cols, width):
+    """Reverse Cuthill-McKee order of the pattern of ``Mob_near J`` without the motor angle,
+    and the bandwidths (kl, ku) it gives.
 
-    The pattern is fixed for a system (coloured differences and the analytic stretching block
-    give the same triplets every call; only the motor-angle column's non-zeros vary and it is
-    not part of the band), so it is computed once and cached on the system.
+    The pattern is fixed for a system and ``width`` (coloured differences and the analytic
+    stretching block give the same triplets every call; only the motor-angle column's
+    non-zeros vary and it is not part of the band), so it is computed once and cached.
     """
-    cached = getattr(system, "_band_cache", None)
-    if cached is not None:
-        return cached
+    cache = system.__dict__.setdefault("_band_cache", {})
+    if width in cache:
+        return cache[width]
     import scipy.sparse as sp
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
     n = system.ny - 1
+    n3 = 3 * system.nb
     keep = (rows < n) & (cols < n)
-    A = sp.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(n, n))
+    J = sp.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(n, n))
+    beads = sp.diags([np.ones(system.nb - abs(k)) for k in range(-width, width + 1)],
+                     list(range(-width, width + 1)))
+    M = sp.block_diag((sp.kron(beads, np.ones((3, 3))), sp.identity(n - n3)), format="csr")
+    A = M @ J
     A = A + A.T + sp.identity(n, format="csr")
     perm = np.asarray(reverse_cuthill_mckee(A.tocsr(), symmetric_mode=True), dtype=np.int64)
     inv = np.empty_like(perm)
     inv[perm] = np.arange(n)
-    r, c = inv[rows[keep]], inv[cols[keep]]
+    A = A.tocoo()
+    r, c = inv[A.row], inv[A.col]
     kl = int(max(0, (r - c).max()))
     ku = int(max(0, (c - r).max()))
-    system._band_cache = (perm, inv, kl, ku)
-    return system._band_cache
+    cache[width] = (perm, inv, kl, ku)
+    return cache[width]
 
 
 class BandedW:
-    """LAPACK banded LU (dgbtrf/dgbtrs) of ``W`` for a local mobility, exact, O(N).
+    """LAPACK banded LU (dgbtrf/dgbtrs) of ``W = I - gamma h Mob_near J``, O(N).
+
+    ``Mob_near``: the mobility between beads at most ``width`` apart along the chain; with
+    ``width = 0`` (default) the self mobility only, which *is* the whole mobility with HI off
+    (then this LU is exact: the default solver for the paper's "without HIs" runs); with HI
+    on it is the preconditioner of :class:`KrylovW` and the ``W`` of :class:`NearW`.
 
     The motor angle ``phi`` is the last unknown; no force depends on it through ``J``'s rows
     (``dphi/dt = omega`` is prescribed), so ``W``'s last row is ``e_phi`` and its last column
     ``w`` only feeds the others: ``u_phi = r_phi``, ``W' u' = r' - w u_phi``. ``W'`` (beads and
     twists) is reordered by reverse Cuthill-McKee, which interleaves beads and twists along
-    the chain and makes it banded (half-bandwidths ~10): factorising costs O(N kl (kl + ku))
-    without sparse-LU bookkeeping. Used with HI off; exact.
+    the chain and makes it banded (half-bandwidths ~10 for ``width = 0``, ~4 more per unit
+    of width): factorising costs O(N kl (kl + ku)) without sparse-LU bookkeeping.
     """
 
-    def __init__(self, system, y, base, G0, gamma_h):
+    def __init__(self, system, y, base, G0, gamma_h, width=0, triplets=None):
         from scipy.linalg.lapack import dgbtrf
 
         from flagwrap._system_kernels import band_from_triplets
 
-        if system.mobility.long_range:
-            raise ValueError("BandedW needs a local mobility (numerics.hydrodynamics = false)")
-        rows, cols, vals = system.force_jacobian_coo(y, base, G0)
-        perm, inv, kl, ku = _band_structure(system, rows, cols)
+        rows, cols, vals = triplets or system.force_jacobian_coo(y, base, G0)
+        width = int(width) if system.mobility.long_range else 0
+        perm, inv, kl, ku = _band_structure(system, rows, cols, width)
         n = system.ny - 1
+        Mb, mt = system.near_field_blocks(y, width)
         ab = np.empty((2 * kl + ku + 1, n), order="F")
         self.w = np.empty(n)
-        band_from_triplets(rows, cols, vals, system.local_mobility_diagonal(), gamma_h, inv,
-                           kl, ku, n, ab, self.w)
+        band_from_triplets(rows, cols, vals, Mb, width, mt, gamma_h, inv, kl, ku, n, ab, self.w)
         lu, piv, info = dgbtrf(ab, kl, ku, overwrite_ab=1)
         if info != 0 or not np.all(np.isfinite(lu)):
             raise SingularW(f"banded LU failed (info {info})")
