@@ -82,7 +82,7 @@ class KrylovW:
     2.6 products per stage instead of 8 with scipy's restarted GMRES (docs/numerics.md).
     """
 
-    max_vectors = 64
+    max_vectors = 40  # ~10-16 directions per step (4 stages) measured; restart when full
 
     def __init__(self, system, y, base, G0, gamma_h, rtol=1e-3, maxiter=200, width=1):
         self.system = system
