@@ -13,16 +13,17 @@ For N = 61, 250, 1000, 4000, 16000:
 * ``Mob F`` with each mobility backend installed here: ``direct`` (numba, vectorised),
   ``direct x T`` (numba threads, only with ``--threads`` > 1), ``fmm`` (FMM3D, eps 1e-6 and
   1e-10), ``jax`` (on whatever device jax has; CPU here), each checked against ``direct``;
-* one ROS34PW2 step with each stage solver: ``dense`` (exact LU, N <= 1000), ``krylov``
-  (matrix-free GMRES to rtol 1e-3, near-field preconditioner; the default above 500
-  unknowns), ``near`` (near-field W-method, one sparse LU, O(N));
-* peak traced memory (tracemalloc: numpy buffers) of one ``krylov`` step (``near`` at
-  N = 16000, where a GMRES step did not finish within 12 min: its iteration count grows with
-  N, ~18 per stage at N = 4000, from step / product cost), to show O(N).
+* ROS34PW2 steps of the real motion (from the stress-free helix at the motor speed, step
+  size from the controller, after untimed warm-up steps) with each stage solver: ``dense``
+  (exact LU, N <= 1000), ``krylov`` (matrix-free GCR to rtol 1e-3 with recycling across
+  stages, banded near-field preconditioner; the default above 300 unknowns), ``near``
+  (near-field W-method, one banded LU, O(N)): wall time per attempted step, accepted
+  fraction and simulated motor turns per wall hour (the throughput that matters: the near
+  W-method's cheap steps are short ones);
+* peak traced memory (tracemalloc: numpy buffers) of one ``krylov`` step, to show O(N).
 
 Prints a table, the crossover N where FMM beats the direct sum (if any), and the steps per
-second of each stepper at N = 1000 (per attempted step; the near W-method also needs ~15x
-more steps, see integrators/linear.py).
+second of each stepper at N = 1000.
 """
 
 from __future__ import annotations
@@ -61,32 +62,39 @@ def best_of(fn, repeat):
     return best
 
 
-def run_steps(s, kind, nstep, trace=False):
-    """Mean wall time per attempted step over ``nstep`` ROS34PW2 steps of the real motion
-    (from the stress-free helix at the motor speed, step size from the controller), after
-    one untimed step (compilation); optionally the peak traced memory."""
+def run_steps(s, kind, nstep, warm, trace=False):
+    """``warm`` untimed steps (compilation, start-up transient), then ``nstep`` timed ones:
+    (wall per attempted step, accepted fraction, turns per wall hour, peak traced memory of
+    one more step or None)."""
     integ = ROS34PW2(tol=1e-5, linear_solver=kind)
     y = s.initial_y()
     info = s.forces(y, s.frames0)
     h = 1e-3 * 2 * np.pi
-    r = integ.step(s, y, info.frames, info, h, 1.0)
-    if r.accepted:
-        y, info = r.y, r.info
-    h = r.h_next
+    for _ in range(warm):
+        r = integ.step(s, y, info.frames, info, h, 1.0)
+        if r.accepted:
+            y, info = r.y, r.info
+        h = r.h_next
+    t_sim = 0.0
+    nacc = 0
     t0 = time.perf_counter()
     for _ in range(nstep):
         r = integ.step(s, y, info.frames, info, h, 1.0)
         if r.accepted:
             y, info = r.y, r.info
+            t_sim += h
+            nacc += 1
         h = r.h_next
-    t = (time.perf_counter() - t0) / nstep
+    wall = time.perf_counter() - t0
+    if nacc == 0:
+        print(f"  ({kind}: no step of {nstep} accepted, h = {h:.2e})", flush=True)
     peak = None
     if trace:  # one more step, traced (tracemalloc slows numpy, so not during the timing)
         tracemalloc.start()
         integ.step(s, y, info.frames, info, h, 1.0)
         peak = tracemalloc.get_traced_memory()[1]
         tracemalloc.stop()
-    return t, peak
+    return wall / nstep, nacc / nstep, t_sim / (2 * np.pi) / wall * 3600.0, peak
 
 
 def main():
@@ -130,13 +138,15 @@ def main():
             print("  ".join(line), flush=True)
             line = ["          step:"]
             for kind in ("dense", "krylov", "near"):
-                if (kind == "dense" and N > 1000) or (kind == "krylov" and N > 4000):
-                    continue  # dense: O(N^2) memory; krylov at 16000: > 12 min per step here
-                nstep = 6 if N <= 1000 else 2
-                t, peak = run_steps(s, kind, nstep,
-                                    trace=(kind == "krylov" or (kind == "near" and N > 4000)))
+                if kind == "dense" and N > 1000:
+                    continue  # O(N^2) memory, O(N^3) time
+                # the controller needs ~10 steps to shrink the first step (1e-3 turn) to what long
+                # chains take at the start, hence the warm-up counts
+                nstep, warm = (40, 10) if N <= 1000 else ((10, 10) if N <= 4000 else (4, 10))
+                t, acc, tph, peak = run_steps(s, kind, nstep, warm, trace=(kind == "krylov"))
                 steps[(N, kind)] = (t, peak)
-                line.append(f"{kind} {t:.4f} s" + (f" (peak {peak / 1e6:.1f} MB)" if peak else ""))
+                line.append(f"{kind} {t:.4f} s (acc {acc:.2f}, {tph:.3g} turns/h"
+                            + (f", peak {peak / 1e6:.1f} MB)" if peak else ")"))
             print("  ".join(line), flush=True)
     fmm = [n for n in sizes if (n, "fmm 1e-6") in prod and prod[(n, "fmm 1e-6")] < prod[(n, "direct")]]
     if any(k[1].startswith("fmm") for k in prod):
@@ -150,7 +160,7 @@ def main():
     big = sorted(n for n in mem if n >= 1000)
     if len(big) >= 2:
         n1, n2 = big[0], big[-1]
-        print(f"step memory (krylov, near at 16000) {n1} -> {n2} beads: x{mem[n2] / mem[n1]:.1f} "
+        print(f"step memory (krylov) {n1} -> {n2} beads: x{mem[n2] / mem[n1]:.1f} "
               f"for x{n2 / n1:.0f} beads")
 
 
