@@ -72,3 +72,12 @@ def scaled_error(system, err: np.ndarray, tol: float) -> float:
     ex = np.abs(err[system.sl_x]).max() / tol if system.nb else 0.0
     et = np.abs(err[system.sl_th]).max() / (10.0 * tol) if system.ne else 0.0
     return float(max(ex, et))
+
+
+def error_weights(system, tol: float) -> np.ndarray:
+    """The absolute error each unknown is held to by :func:`scaled_error` (``inf`` for the
+    prescribed motor angle): positions ``tol``, twist angles ``10 tol``."""
+    w = np.full(system.ny, np.inf)
+    w[system.sl_x] = tol
+    w[system.sl_th] = 10.0 * tol
+    return w

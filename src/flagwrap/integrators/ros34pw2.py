@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from flagwrap.integrators.base import AdaptiveMixin, Integrator, StepResult, scaled_error
+from flagwrap.integrators.base import (AdaptiveMixin, Integrator, StepResult, error_weights,
+                                      scaled_error)
 from flagwrap.integrators.linear import SingularW, make_w
 
 GAMMA = 4.3586652150845900e-01
@@ -53,7 +54,10 @@ class ROS34PW2(AdaptiveMixin, Integrator):
 
     def step(self, system, y, base, info, h, omega) -> StepResult:
         try:
-            W = make_w(self.linear_solver, system, y, base, info.G, GAMMA * h)
+            # stage increments U_i enter y_new and the error estimate with O(1) weights, so
+            # an iterative solve needs each to kappa x the step tolerance
+            W = make_w(self.linear_solver, system, y, base, info.G, GAMMA * h,
+                       err_scale=error_weights(system, self.tol))
         except SingularW as exc:
             return self.reject(h, f"singular W ({exc})")
         s = 4

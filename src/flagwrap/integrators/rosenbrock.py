@@ -20,7 +20,8 @@ import math
 
 import numpy as np
 
-from flagwrap.integrators.base import AdaptiveMixin, Integrator, StepResult, scaled_error
+from flagwrap.integrators.base import (AdaptiveMixin, Integrator, StepResult, error_weights,
+                                      scaled_error)
 from flagwrap.integrators.linear import SingularW, make_w
 
 GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
@@ -39,7 +40,10 @@ class ROS2(AdaptiveMixin, Integrator):
         f0 = system.apply_mobility(y, G0)
         f0[-1] = omega
         try:
-            W = make_w(self.linear_solver, system, y, base, G0, GAMMA * h)
+            # the stages k_i are rates: y moves by ~h k_i, so an iterative solve needs them to
+            # kappa x tol / h
+            W = make_w(self.linear_solver, system, y, base, G0, GAMMA * h,
+                       err_scale=error_weights(system, self.tol) / h)
             k1 = W.solve(f0)
         except SingularW as exc:
             return self.reject(h, f"singular W ({exc})")
