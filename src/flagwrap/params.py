@@ -392,10 +392,11 @@ class Numerics:
         sweep records the case as failed; ``flagwrap sweep --retry-failed`` reruns it).
     linear_solver : {"auto", "dense", "near", "krylov", "banded", "sparse"}
         solver of the Rosenbrock stage equations (:mod:`flagwrap.integrators.linear`): exact
-        dense LU, sparse LU of the near-field ``W`` (a W-method approximation, O(N)), GMRES
-        (matrix-free, near-field preconditioned, rtol 1e-3), or exact banded / sparse LU (HI
-        off only). "auto": banded with HI off; with HI dense up to 500 unknowns (N ~ 125),
-        GMRES above (measured crossover).
+        dense LU, banded LU of the near-field ``W`` (a W-method approximation, O(N)), GCR
+        (matrix-free, banded near-field preconditioner, recycled across stages; to rtol 1e-3
+        and 0.1 x ``tol`` per unknown), or exact banded / sparse LU (HI off only). "auto":
+        banded with HI off; with HI dense up to 300 unknowns (N ~ 76), GCR above (measured
+        crossover).
     dt_min : float
         smallest step [turns] before the run is declared stuck.
     save_every : float
