@@ -151,6 +151,28 @@ def test_banded_near_field_w_matches_the_masked_dense_w(width):
     assert np.abs(u - ref).max() <= 1e-10 * np.abs(ref).max()
 
 
+def test_krylov_error_test_tightens_the_solve_beyond_the_residual_test():
+    """With ``err_scale`` the GCR solve must also bring its per-unknown error estimate below
+    ``kappa err_scale``: a tiny scale forces a near-exact solution although rtol is 1e-3."""
+    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
+    s = RodSystem(cfg)
+    rng = np.random.default_rng(7)
+    y = s.initial_y()
+    y[s.sl_x] += 1e-4 * rng.standard_normal(3 * s.nb)
+    info = s.forces(y, s.frames0)
+    gh = 3e-2
+    r = rng.standard_normal(s.ny)
+    ud = DenseW(s, y, info.frames, info.G, gh).solve(r)
+    loose = KrylovW(s, y, info.frames, info.G, gh, rtol=1e-3)
+    ul = loose.solve(r)
+    tight = KrylovW(s, y, info.frames, info.G, gh, rtol=1e-3,
+                    err_scale=np.full(s.ny, 1e-11 * np.abs(ud).max()), kappa=1.0)
+    ut = tight.solve(r)
+    assert tight.iterations > loose.iterations
+    assert np.abs(ut - ud).max() <= 1e-9 * np.abs(ud).max()
+    assert np.abs(ul - ud).max() > 10 * np.abs(ut - ud).max()
+
+
 def test_sparse_and_dense_jacobians_agree():
     cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
     s = RodSystem(cfg)
@@ -216,8 +238,8 @@ def test_near_field_w_method_converges_to_the_exact_w_solution():
     assert diffs[1] < 0.4 * diffs[0]  # order >= 1 in tol (10x tighter tol -> >= 2.5x closer)
 
 
-def test_inexact_gmres_stage_solves_track_the_exact_lu():
-    # rtol 1e-3 on stage increments of ~1e-3 L leaves ~1e-6 L per step, below the step
+def test_inexact_krylov_stage_solves_track_the_exact_lu():
+    # GCR to rtol 1e-3 and 0.1 x tol per unknown leaves ~1e-6 L per step, below the step
     # tolerance 1e-5: the trajectory must agree with the exact-LU one to a few tolerances
     p = (("ccw", 0.3), ("cw", 0.2))
     exact, kry = _run_with("dense", p), _run_with("krylov", p)
