@@ -200,6 +200,12 @@ class RodSystem:
         """Near-field ``Mob`` (core units) for banded solvers: translational 3x3 blocks
         ``(nb, 2 width + 1, 3, 3)`` between beads at most ``width`` apart along the chain
         (only the self blocks for a local mobility) and the twist diagonal ``(ne,)``."""
+        if not self.mobility.long_range:  # constant: computed once (HI off, every step)
+            cached = self.__dict__.get("_local_blocks")
+            if cached is None:
+                Mb = self.mobility.near_field_blocks(np.zeros((self.nb, 3)), 0) / self.machin
+                cached = self._local_blocks = (Mb, 1.0 / (self.machin * self.rot_drag[self.ec:]))
+            return cached
         x, _, _ = self.unpack(y)
         Mb = self.mobility.near_field_blocks(x[self.nc:], width)
         Mb /= self.machin
