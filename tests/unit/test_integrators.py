@@ -173,6 +173,52 @@ def test_krylov_error_test_tightens_the_solve_beyond_the_residual_test():
     assert np.abs(ul - ud).max() > 10 * np.abs(ut - ud).max()
 
 
+def test_gcr_restart_when_its_storage_is_full_still_solves_exactly():
+    """Recycled directions over four solves with room for only two: each restart keeps the
+    current x and r, so every solve still reaches rtol against the dense LU."""
+    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
+    s = RodSystem(cfg)
+    rng = np.random.default_rng(8)
+    y = s.initial_y()
+    y[s.sl_x] += 1e-4 * rng.standard_normal(3 * s.nb)
+    info = s.forces(y, s.frames0)
+
+    class TinyGCR(KrylovW):
+        max_vectors = 2
+
+    D = DenseW(s, y, info.frames, info.G, 3e-2)
+    K = TinyGCR(s, y, info.frames, info.G, 3e-2, rtol=1e-10, maxiter=2000)
+    for _ in range(4):
+        r = rng.standard_normal(s.ny)
+        ud = D.solve(r)
+        assert np.abs(K.solve(r) - ud).max() <= 1e-8 * np.abs(ud).max()
+    assert K.iterations > 2 * 4  # it did have to restart
+
+
+def test_near_field_w_on_a_chain_shorter_than_its_near_field_is_the_exact_w():
+    # default width 4a/b + 4 = 5 beads > the 3 free beads of a 5-bead chain: the near field
+    # is then the whole mobility and NearW must equal the dense LU
+    from flagwrap.integrators.linear import NearW
+
+    s = RodSystem(make_config(machin=283, filament=paper_filament(n_beads=5)))
+    y = s.initial_y()
+    info = s.forces(y, s.frames0)
+    r = np.random.default_rng(9).standard_normal(s.ny)
+    ud = DenseW(s, y, info.frames, info.G, 1e-2).solve(r)
+    un = NearW(s, y, info.frames, info.G, 1e-2).solve(r)
+    assert np.abs(un - ud).max() <= 1e-10 * np.abs(ud).max()
+
+
+def test_banded_solver_refuses_long_range_hydrodynamics():
+    from flagwrap.integrators.linear import make_w
+
+    s = RodSystem(make_config(machin=283, filament=paper_filament(n_beads=11)))
+    y = s.initial_y()
+    info = s.forces(y, s.frames0)
+    with pytest.raises(ValueError, match="hydrodynamics = false"):
+        make_w("banded", s, y, info.frames, info.G, 1e-2)
+
+
 def test_sparse_and_dense_jacobians_agree():
     cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
     s = RodSystem(cfg)

@@ -61,4 +61,4 @@ def test_clamp_positions_are_rotations_about_the_motor_axis(phi, axis):
     x0 = np.array([[0.1, -0.2, 0.3], [0.4, 0.5, -0.6], [1.0, 1.0, 1.0]])
     clamp = AxialClamp(x0, np.zeros(2), axis=axis)
     Rm = rotation_matrix(np.asarray(axis), phi)
-    assert np.allclose(clamp.positions(phi), x0[:2] @ Rm.T, atol=1e-13)
+    np.testing.assert_allclose(clamp.positions(phi), x0[:2] @ Rm.T, rtol=0, atol=1e-13)

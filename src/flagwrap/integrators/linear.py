@@ -23,7 +23,7 @@
 ``make_w(kind, ...)`` picks one; ``"auto"``: banded with HI off, dense up to
 ``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover is measured (long chain of
 benchmarks/scaling.py, 0.3-0.5 turn from rest, same steps both ways, one core): N = 61
-(237 unknowns) dense 1.59 vs krylov 1.73 ms per step; N = 80 (317) 2.24 vs 1.91; N = 95
+(237 unknowns) dense 1.59 vs krylov 1.73 ms per step; N = 80 (313) 2.24 vs 1.91; N = 95
 3.56 vs 1.96; N = 120 4.69 vs 2.61 (docs/numerics.md).
 """
 
@@ -79,13 +79,13 @@ class KrylovW:
     right-hand side on them (no product needed) and then iterates only on what is left
     (recycling, as in GCRO: Parks et al., SIAM J. Sci. Comput. 28, 1651, 2006).
 
-    Stopping rule, both: relative residual ``rtol = 1e-3`` (true residual, updated exactly in
-    exact arithmetic) and, when the integrator passes ``err_scale`` (the absolute accuracy it
+    Stopping rule, both: relative residual ``rtol = 1e-3`` (the recursively updated residual,
+    equal to the true one in exact arithmetic) and, when the integrator passes ``err_scale`` (the absolute accuracy it
     holds each unknown to), an estimated solution error ``|P^-1 r| <= kappa err_scale`` per
     unknown with ``kappa = 0.1`` (CVODE likewise solves its Krylov systems to 0.05 x its
     nonlinear tolerance). Measured on benchmarks/scaling.py's chain: at N = 1000 the residual
     test alone already gives the steps of exact solves (0.03 turn: 728 steps, 42 ms per
-    step; with the error test 734 steps, 53 ms); at N = 8000 it does not: its solve errors,
+    step; with both tests 767 steps, 54 ms); at N = 8000 it does not: its solve errors,
     concentrated where the right-hand side is small, drove the step from ~5e-5 to ~5e-7
     (1/omega) and the error test restores ~2e-5 (0.0002 turn in 175 steps).
     """
@@ -236,7 +236,7 @@ class BandedW:
     (``dphi/dt = omega`` is prescribed), so ``W``'s last row is ``e_phi`` and its last column
     ``w`` only feeds the others: ``u_phi = r_phi``, ``W' u' = r' - w u_phi``. ``W'`` (beads and
     twists) is reordered by reverse Cuthill-McKee, which interleaves beads and twists along
-    the chain and makes it banded (half-bandwidths ~10 for ``width = 0``, ~4 more per unit
+    the chain and makes it banded (half-bandwidths ~10 for ``width = 0``, ~5 more per unit
     of width): factorising costs O(N kl (kl + ku)) without sparse-LU bookkeeping.
     """
 
@@ -246,7 +246,8 @@ class BandedW:
         from flagwrap._system_kernels import band_from_triplets
 
         rows, cols, vals = triplets or system.force_jacobian_coo(y, base, G0)
-        width = int(width) if system.mobility.long_range else 0
+        # pairs farther apart than the chain is long do not exist: clamp (short chains)
+        width = min(int(width), max(system.nb - 1, 0)) if system.mobility.long_range else 0
         perm, inv, kl, ku = _band_structure(system, rows, cols, width)
         n = system.ny - 1
         Mb, mt = system.near_field_blocks(y, width)
@@ -310,6 +311,8 @@ def make_w(kind, system, y, base, G0, gamma_h, err_scale=None):
         else:
             kind = "dense" if system.ny <= AUTO_CROSSOVER_NY else "krylov"
     if kind == "banded":
+        if system.mobility.long_range:  # the local-mobility LU would be an approximation
+            raise ValueError("linear solver 'banded' needs numerics.hydrodynamics = false")
         return BandedW(system, y, base, G0, gamma_h)
     if kind == "sparse":
         return SparseW(system, y, base, G0, gamma_h)
