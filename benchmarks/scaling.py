@@ -16,7 +16,7 @@ For N = 61, 250, 1000, 4000, 16000:
 * ROS34PW2 steps of the real motion (from the stress-free helix at the motor speed, step
   size from the controller, after untimed warm-up steps) with each stage solver: ``dense``
   (exact LU, N <= 1000), ``krylov`` (matrix-free GCR to rtol 1e-3 and 0.1 x the step tolerance per unknown, recycling across
-  stages, banded near-field preconditioner; the default above 300 unknowns), ``near``
+  stages, banded near-field preconditioner; the default above 400 unknowns), ``near``
   (near-field W-method, one banded LU, O(N)): wall time per attempted step, accepted
   fraction and simulated motor turns per wall hour (the throughput that matters: the near
   W-method's cheap steps are short ones);

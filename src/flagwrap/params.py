@@ -395,7 +395,7 @@ class Numerics:
         dense LU, banded LU of the near-field ``W`` (a W-method approximation, O(N)), GCR
         (matrix-free, banded near-field preconditioner, recycled across stages; to rtol 1e-3
         and 0.1 x the step tolerance per unknown), or exact banded / sparse LU (HI off only). "auto":
-        banded with HI off; with HI dense up to 300 unknowns (N ~ 76), GCR above (measured
+        banded with HI off; with HI dense up to 400 unknowns (N ~ 100), GCR above (measured
         crossover).
     dt_min : float
         smallest step [turns] before the run is declared stuck.

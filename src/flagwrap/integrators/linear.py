@@ -21,10 +21,11 @@
   mobility: banded, O(N).
 
 ``make_w(kind, ...)`` picks one; ``"auto"``: banded with HI off, dense up to
-``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover is measured (long chain of
-benchmarks/scaling.py, 0.3-0.5 turn from rest, same steps both ways, one core): N = 61
-(237 unknowns) dense 1.59 vs krylov 1.73 ms per step; N = 80 (313) 2.24 vs 1.91; N = 95
-3.56 vs 1.96; N = 120 4.69 vs 2.61 (docs/numerics.md).
+``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover is measured (one core, same
+tolerance, whole intervals from rest): Fig. 4(a) helix refined at fixed L, 0.2 turn: N = 91
+(357 unknowns) dense 0.66 s vs GCR 0.97 s, N = 121 (477) 1.30 vs 1.11 s; benchmarks/scaling.py's
+chain (fixed bond): N = 95 (373) 1.60 vs 1.56 s over 0.3 turn, N = 120 (473) 1.69 vs 1.20 s
+over 0.2 turn (docs/numerics.md).
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ import math
 import numpy as np
 import scipy.linalg as sla
 
-AUTO_CROSSOVER_NY = 300
+AUTO_CROSSOVER_NY = 400
 KAPPA = 0.1  # iterative stage solves stop at kappa x the step's error tolerance
 
 
@@ -67,17 +68,31 @@ class DenseW:
         return sla.lu_solve(self.lu, rhs, check_finite=False)
 
 
+def preconditioner_width(system) -> int:
+    """Beads along the chain whose mutual mobility the GCR preconditioner keeps.
+
+    A pair k beads apart couples with ~(3/4..3/2) a / (k b) of the self mobility (Oseen,
+    transverse..longitudinal), so the preconditioner keeps pairs down to ~10 %: k <= 15 a/b.
+    Measured GCR iterations per stage (Fig. 4(a) helix at fixed L, 0.1 turn): a/b = 0.68
+    (N = 181) width 1/3/6/8/12: 133/36/8.2/5.7/3.3, ms per step 105/33/11.8/11.1/8.9 (dense
+    LU 14.0); a/b = 0.90 (N = 241) width 6/8/12/16/24: 53/30/7.4/3.7/2.8 iterations, 73/47/
+    19.2/15.5/17.7 ms (dense 27.5). At a/b = 0.225 (benchmarks/scaling.py's chain) width 1-2
+    is best and 4-5 costs ~15 % more per step.
+    """
+    return max(1, math.ceil(15.0 * system.radius / system.bond))
+
+
 class KrylovW:
     """Matrix-free ``W`` solved by preconditioned GCR with subspace recycling.
 
     ``W v = v - gamma h Mob (J v)``: ``J`` sparse (coloured Jacobian), ``Mob`` applied
     matrix-free (O(N^2) direct sum or any backend; O(N) memory). Right preconditioner: the
     banded LU of the near-field ``W`` (:class:`BandedW`, RPY blocks of beads within
-    ``width`` along the chain). GCR (Eisenstat, Elman & Schultz 1983) keeps every search
-    direction ``z`` with ``W z`` orthonormalised, so the four stages of a Rosenbrock step,
-    which share ``W``, reuse the earlier stages' directions: each solve first projects its
-    right-hand side on them (no product needed) and then iterates only on what is left
-    (recycling, as in GCRO: Parks et al., SIAM J. Sci. Comput. 28, 1651, 2006).
+    ``width`` along the chain, default :func:`preconditioner_width`). GCR (Eisenstat, Elman
+    & Schultz 1983) keeps every search direction ``z`` with ``W z`` orthonormalised, so the
+    four stages of a Rosenbrock step, which share ``W``, reuse the earlier stages'
+    directions: each solve first projects its right-hand side on them (no product needed)
+    and then iterates only on what is left (recycling, as in GCRO: Parks et al., SIAM J. Sci. Comput. 28, 1651, 2006).
 
     Stopping rule, both: relative residual ``rtol = 1e-3`` (the recursively updated residual,
     equal to the true one in exact arithmetic) and, when the integrator passes ``err_scale`` (the absolute accuracy it
@@ -92,8 +107,10 @@ class KrylovW:
 
     max_vectors = 40  # ~10-16 directions per step (4 stages) measured; restart when full
 
-    def __init__(self, system, y, base, G0, gamma_h, rtol=1e-3, maxiter=200, width=1,
+    def __init__(self, system, y, base, G0, gamma_h, rtol=1e-3, maxiter=200, width=None,
                  err_scale=None, kappa=KAPPA):
+        if width is None:
+            width = preconditioner_width(system)
         self.system = system
         self.y = y
         self.gh = gamma_h
