@@ -61,6 +61,32 @@ def rpy_matrix(x, a, out):
                     out[3 * j + m, 3 * i + k] = v
 
 
+@nb.njit(cache=True, inline="always")
+def _rpy_constants(a):
+    """(s, c8, aa, four_aa, kn, kg, floor): the per-radius constants of the pair loops."""
+    aa = a * a
+    return (1.0 / (6.0 * math.pi * a), 1.0 / (8.0 * math.pi), aa, 4.0 * aa,
+            9.0 / (32.0 * a), 3.0 / (32.0 * a), 1e-32 * aa)
+
+
+def _rpy_pair_coefficients(r2, s, c8, aa, four_aa, kn, kg, floor):
+    """(f, g) with mu_hat_ij = f I + g d d (d = x_i - x_j, r2 = |d|^2), branch-free form of
+    :func:`_pair` (see :func:`_rpy_gather_rows`)."""
+    r2 = max(r2, floor)
+    ir = 1.0 / math.sqrt(r2)
+    ir2 = ir * ir
+    cf = c8 * ir
+    q = aa * ir2
+    far = r2 >= four_aa
+    f = cf * (1.0 + (2.0 / 3.0) * q) if far else s * (1.0 - kn * r2 * ir)
+    g = cf * (1.0 - 2.0 * q) * ir2 if far else s * kg * ir
+    return f, g
+
+
+_coef = nb.njit(cache=True, fastmath=True, error_model="numpy", inline="always")(
+    _rpy_pair_coefficients)
+
+
 def _rpy_gather_rows(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, i0, i1):
     """Rows ``i0 <= i < i1`` of ``mu_hat F`` in structure-of-arrays layout.
 
@@ -72,13 +98,7 @@ def _rpy_gather_rows(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, i0, i1):
     (r = 0) takes the overlap branch, whose value at r = 0 is exactly the self mobility
     ``1/(6 pi a)``; ``r^2`` is floored at ``1e-32 a^2`` (the self term is then exact to 3e-17, and no term overflows).
     """
-    s = 1.0 / (6.0 * math.pi * a)
-    c8 = 1.0 / (8.0 * math.pi)
-    aa = a * a
-    four_aa = 4.0 * aa
-    floor = 1e-32 * aa
-    kn = 9.0 / (32.0 * a)
-    kg = 3.0 / (32.0 * a)
+    s, c8, aa, four_aa, kn, kg, floor = _rpy_constants(a)
     n = xs.shape[0]
     for i in range(i0, i1):
         xi = xs[i]
@@ -91,14 +111,7 @@ def _rpy_gather_rows(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, i0, i1):
             d0 = xi - xs[j]
             d1 = yi - ys[j]
             d2 = zi - zs[j]
-            r2 = max(d0 * d0 + d1 * d1 + d2 * d2, floor)
-            ir = 1.0 / math.sqrt(r2)
-            ir2 = ir * ir
-            cf = c8 * ir
-            q = aa * ir2
-            far = r2 >= four_aa
-            f = cf * (1.0 + (2.0 / 3.0) * q) if far else s * (1.0 - kn * r2 * ir)
-            g = cf * (1.0 - 2.0 * q) * ir2 if far else s * kg * ir
+            f, g = _coef(d0 * d0 + d1 * d1 + d2 * d2, s, c8, aa, four_aa, kn, kg, floor)
             fxj = fx[j]
             fyj = fy[j]
             fzj = fz[j]
@@ -146,24 +159,6 @@ def _rpy_apply_serial(x, a, F, out):
     _aos(ox, oy, oz, out)
 
 
-def _rpy_pair_coefficients(r2, s, c8, aa, four_aa, kn, kg, floor):
-    """(f, g) with mu_hat_ij = f I + g d d (d = x_i - x_j, r2 = |d|^2), branch-free form of
-    :func:`_pair` (see :func:`_rpy_gather_rows`)."""
-    r2 = max(r2, floor)
-    ir = 1.0 / math.sqrt(r2)
-    ir2 = ir * ir
-    cf = c8 * ir
-    q = aa * ir2
-    far = r2 >= four_aa
-    f = cf * (1.0 + (2.0 / 3.0) * q) if far else s * (1.0 - kn * r2 * ir)
-    g = cf * (1.0 - 2.0 * q) * ir2 if far else s * kg * ir
-    return f, g
-
-
-_coef = nb.njit(cache=True, fastmath=True, error_model="numpy", inline="always")(
-    _rpy_pair_coefficients)
-
-
 @nb.njit(cache=True, fastmath=True, error_model="numpy")
 def _sym_row(xi, yi, zi, fxi, fyi, fzi, bx, by, bz, bfx, bfy, bfz, tx, ty, tz,
              s, c8, aa, four_aa, kn, kg, floor):
@@ -200,12 +195,7 @@ def _rpy_apply_sym(x, a, F, out, block):
     N = 1000: 0.94 vs 1.41 ms; 16000: 220 vs 361 ms). Serial only."""
     n = x.shape[0]
     xs, ys, zs, fx, fy, fz = _soa(x, F)
-    s = 1.0 / (6.0 * math.pi * a)
-    c8 = 1.0 / (8.0 * math.pi)
-    aa = a * a
-    floor = 1e-32 * aa
-    kn = 9.0 / (32.0 * a)
-    kg = 3.0 / (32.0 * a)
+    s, c8, aa, four_aa, kn, kg, floor = _rpy_constants(a)
     ox = s * fx
     oy = s * fy
     oz = s * fz
@@ -222,7 +212,7 @@ def _rpy_apply_sym(x, a, F, out, block):
                                   xs[j0 + lo:j1], ys[j0 + lo:j1], zs[j0 + lo:j1],
                                   fx[j0 + lo:j1], fy[j0 + lo:j1], fz[j0 + lo:j1],
                                   tx[lo:m], ty[lo:m], tz[lo:m],
-                                  s, c8, aa, 4.0 * aa, kn, kg, floor)
+                                  s, c8, aa, four_aa, kn, kg, floor)
             ox[i] += a0
             oy[i] += a1
             oz[i] += a2
