@@ -111,13 +111,18 @@ def test_fast_steppers_agree_with_explicit_euler_reference():
         assert np.abs(info.x - x_euler).max() < 1e-7
 
 
-def test_krylov_solver_matches_dense_lu():
-    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
-    s = RodSystem(cfg)
-    rng = np.random.default_rng(4)
+def _kicked_state(n_beads, seed, kick=1e-4):
+    """The paper filament (HI on, M = 283) with its free beads kicked by ``kick`` L at random:
+    (system, the generator after the kick, state, forces)."""
+    s = RodSystem(make_config(machin=283, filament=paper_filament(n_beads=n_beads)))
+    rng = np.random.default_rng(seed)
     y = s.initial_y()
-    y[s.sl_x] += 1e-4 * rng.standard_normal(3 * s.nb)
-    info = s.forces(y, s.frames0)
+    y[s.sl_x] += kick * rng.standard_normal(3 * s.nb)
+    return s, rng, y, s.forces(y, s.frames0)
+
+
+def test_krylov_solver_matches_dense_lu():
+    s, rng, y, info = _kicked_state(31, seed=4)
     for gh in (1e-3, 3e-2):
         D = DenseW(s, y, info.frames, info.G, gh)
         K = KrylovW(s, y, info.frames, info.G, gh, rtol=1e-10)
@@ -130,12 +135,7 @@ def test_krylov_solver_matches_dense_lu():
 def test_banded_near_field_w_matches_the_masked_dense_w(width):
     """The banded LU of ``I - gamma h Mob_near J`` against a dense LU of the same operator
     built independently: the dense RPY matrix with blocks beyond ``width`` beads zeroed."""
-    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
-    s = RodSystem(cfg)
-    rng = np.random.default_rng(6)
-    y = s.initial_y()
-    y[s.sl_x] += 1e-3 * rng.standard_normal(3 * s.nb)
-    info = s.forces(y, s.frames0)
+    s, rng, y, info = _kicked_state(31, seed=6, kick=1e-3)
     gh = 2e-2
     Mob = s.mobility_matrix(y)
     bead = np.arange(s.ny) // 3
@@ -154,12 +154,7 @@ def test_banded_near_field_w_matches_the_masked_dense_w(width):
 def test_krylov_error_test_tightens_the_solve_beyond_the_residual_test():
     """With ``err_scale`` the GCR solve must also bring its per-unknown error estimate below
     ``kappa err_scale``: a tiny scale forces a near-exact solution although rtol is 1e-3."""
-    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
-    s = RodSystem(cfg)
-    rng = np.random.default_rng(7)
-    y = s.initial_y()
-    y[s.sl_x] += 1e-4 * rng.standard_normal(3 * s.nb)
-    info = s.forces(y, s.frames0)
+    s, rng, y, info = _kicked_state(31, seed=7)
     gh = 3e-2
     r = rng.standard_normal(s.ny)
     ud = DenseW(s, y, info.frames, info.G, gh).solve(r)
@@ -176,12 +171,7 @@ def test_krylov_error_test_tightens_the_solve_beyond_the_residual_test():
 def test_gcr_restart_when_its_storage_is_full_still_solves_exactly():
     """Recycled directions over four solves with room for only two: each restart keeps the
     current x and r, so every solve still reaches rtol against the dense LU."""
-    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
-    s = RodSystem(cfg)
-    rng = np.random.default_rng(8)
-    y = s.initial_y()
-    y[s.sl_x] += 1e-4 * rng.standard_normal(3 * s.nb)
-    info = s.forces(y, s.frames0)
+    s, rng, y, info = _kicked_state(31, seed=8)
 
     class TinyGCR(KrylovW):
         max_vectors = 2
@@ -225,12 +215,8 @@ def test_gcr_preconditioner_width_follows_the_bead_overlap():
     ceil(15 a/b) = 11 must bring that to a few tens and still solve exactly."""
     from flagwrap.integrators.linear import preconditioner_width
 
-    s = RodSystem(make_config(machin=283, filament=paper_filament(n_beads=181)))
+    s, rng, y, info = _kicked_state(181, seed=3)
     assert preconditioner_width(s) == math.ceil(15 * s.radius / s.bond) == 11
-    rng = np.random.default_rng(3)
-    y = s.initial_y()
-    y[s.sl_x] += 1e-4 * rng.standard_normal(3 * s.nb)
-    info = s.forces(y, s.frames0)
     r = rng.standard_normal(s.ny)
     narrow = KrylovW(s, y, info.frames, info.G, 1e-2, rtol=1e-6, maxiter=2000, width=1)
     narrow.solve(r)
