@@ -242,8 +242,9 @@ def rpy_apply(x, a, F, out, threads=1):
 
     One compiled call (the structure-of-arrays copies are made inside, so the Python overhead
     stays ~1 us at N = 61). Serial: the gather loop below ``SYMMETRIC_MIN_N`` beads, the
-    once-per-pair loop :func:`_rpy_apply_sym` above. ``threads > 1`` splits the rows over numba threads (the same
-    pair sums per row; equal to rounding, not necessarily bit for bit).
+    once-per-pair loop :func:`_rpy_apply_sym` above. ``threads > 1`` splits the rows over
+    numba threads (the same pair sums per row; equal to rounding, not necessarily bit for
+    bit).
     """
     if threads > 1 and x.shape[0] >= 256:
         _rpy_apply_parallel(x, float(a), F, out, 8 * threads)

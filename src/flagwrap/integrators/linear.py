@@ -92,13 +92,14 @@ class KrylovW:
     & Schultz 1983) keeps every search direction ``z`` with ``W z`` orthonormalised, so the
     four stages of a Rosenbrock step, which share ``W``, reuse the earlier stages'
     directions: each solve first projects its right-hand side on them (no product needed)
-    and then iterates only on what is left (recycling, as in GCRO: Parks et al., SIAM J. Sci. Comput. 28, 1651, 2006).
+    and then iterates only on what is left (recycling, as in GCRO: Parks et al., SIAM J.
+    Sci. Comput. 28, 1651, 2006).
 
     Stopping rule, both: relative residual ``rtol = 1e-3`` (the recursively updated residual,
-    equal to the true one in exact arithmetic) and, when the integrator passes ``err_scale`` (the absolute accuracy it
-    holds each unknown to), an estimated solution error ``|P^-1 r| <= kappa err_scale`` per
-    unknown with ``kappa = 0.1`` (CVODE likewise solves its Krylov systems to 0.05 x its
-    nonlinear tolerance). Measured on benchmarks/scaling.py's chain: at N = 1000 the residual
+    equal to the true one in exact arithmetic) and, when the integrator passes ``err_scale``
+    (the absolute accuracy it holds each unknown to), an estimated solution error
+    ``|P^-1 r| <= kappa err_scale`` per unknown with ``kappa = 0.1`` (CVODE likewise solves
+    its Krylov systems to 0.05 x its nonlinear tolerance). Measured on benchmarks/scaling.py's chain: at N = 1000 the residual
     test alone already gives the steps of exact solves (0.03 turn: 728 steps, 42 ms per
     step; with both tests 767 steps, 54 ms); at N = 8000 it does not: its solve errors,
     concentrated where the right-hand side is small, drove the step from ~5e-5 to ~5e-7
@@ -109,6 +110,8 @@ class KrylovW:
 
     def __init__(self, system, y, base, G0, gamma_h, rtol=1e-3, maxiter=200, width=None,
                  err_scale=None, kappa=KAPPA):
+        import scipy.sparse as sp
+
         if width is None:
             width = preconditioner_width(system)
         self.system = system
@@ -119,8 +122,6 @@ class KrylovW:
         self.inv_scale = None if err_scale is None else 1.0 / np.asarray(err_scale, float)
         self.kappa = kappa
         rows, cols, vals = system.force_jacobian_coo(y, base, G0)
-        import scipy.sparse as sp
-
         self.J = sp.csr_matrix((vals, (rows, cols)), shape=(system.ny, system.ny))
         self.P = BandedW(system, y, base, G0, gamma_h, width=width,
                          triplets=(rows, cols, vals))
