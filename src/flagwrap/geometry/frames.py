@@ -21,27 +21,37 @@ def cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
+@nb.njit(cache=True, inline="always")
+def transport3(a0, a1, a2, b0, b1, b2, v0, v1, v2):
+    """:func:`transport` on scalars (tangents ``a``, ``b``, vector ``v``): returns a tuple and
+    allocates nothing, for the kernels that transport every bond at every force call."""
+    c = a0 * b0 + a1 * b1 + a2 * b2
+    k0, k1, k2 = cross(a0, a1, a2, b0, b1, b2)
+    kx0, kx1, kx2 = cross(k0, k1, k2, v0, v1, v2)
+    kv = (k0 * v0 + k1 * v1 + k2 * v2) / (1.0 + c)
+    return c * v0 + kx0 + kv * k0, c * v1 + kx1 + kv * k1, c * v2 + kx2 + kv * k2
+
+
 @nb.njit(cache=True)
 def transport(t1, t2, v):
     """Parallel transport of ``v`` (3,) from unit tangent ``t1`` to ``t2``."""
-    c = t1[0] * t2[0] + t1[1] * t2[1] + t1[2] * t2[2]
-    b0, b1, b2 = cross(t1[0], t1[1], t1[2], t2[0], t2[1], t2[2])
-    bxv0, bxv1, bxv2 = cross(b0, b1, b2, v[0], v[1], v[2])
-    bv = (b0 * v[0] + b1 * v[1] + b2 * v[2]) / (1.0 + c)
     out = np.empty(3)
-    out[0] = c * v[0] + bxv0 + bv * b0
-    out[1] = c * v[1] + bxv1 + bv * b1
-    out[2] = c * v[2] + bxv2 + bv * b2
+    out[0], out[1], out[2] = transport3(t1[0], t1[1], t1[2], t2[0], t2[1], t2[2],
+                                        v[0], v[1], v[2])
     return out
+
+
+@nb.njit(cache=True, inline="always")
+def signed_angle3(u0, u1, u2, v0, v1, v2, a0, a1, a2):
+    """:func:`signed_angle` on scalars."""
+    c0, c1, c2 = cross(u0, u1, u2, v0, v1, v2)
+    return math.atan2(c0 * a0 + c1 * a1 + c2 * a2, u0 * v0 + u1 * v1 + u2 * v2)
 
 
 @nb.njit(cache=True)
 def signed_angle(u, v, axis):
     """Angle from ``u`` to ``v`` about ``axis`` in (-pi, pi] (vectors perpendicular to ``axis``)."""
-    c0, c1, c2 = cross(u[0], u[1], u[2], v[0], v[1], v[2])
-    s = c0 * axis[0] + c1 * axis[1] + c2 * axis[2]
-    c = u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
-    return math.atan2(s, c)
+    return signed_angle3(u[0], u[1], u[2], v[0], v[1], v[2], axis[0], axis[1], axis[2])
 
 
 def perpendicular(t: np.ndarray) -> np.ndarray:
