@@ -102,6 +102,7 @@ class RodSystem:
         w[0] += 0.5
         w[-1] += 0.5
         self.rot_drag = 8.0 * math.pi * self.radius**3 * w  # geometric, times M gives core drag
+        self.twist_mobility = 1.0 / (self.machin * self.rot_drag[self.ec:])  # free bonds, core
         # cell body
         if config.body.enabled:
             R = fil.helix_radius
@@ -193,7 +194,7 @@ class RodSystem:
         """Diagonal of the self (no-HI) mobility in core units, (ny,); 0 for the motor angle."""
         d = np.zeros(self.ny)
         d[self.sl_x] = 1.0 / (6.0 * math.pi * self.radius * self.machin)
-        d[self.sl_th] = 1.0 / (self.machin * self.rot_drag[self.ec:])
+        d[self.sl_th] = self.twist_mobility
         return d
 
     def near_field_blocks(self, y: np.ndarray, width: int):
@@ -201,22 +202,22 @@ class RodSystem:
         ``(nb, 2 width + 1, 3, 3)`` between beads at most ``width`` apart along the chain
         (only the self blocks for a local mobility) and the twist diagonal ``(ne,)``."""
         if not self.mobility.long_range:  # constant: computed once (HI off, every step)
-            cached = self.__dict__.get("_local_blocks")
-            if cached is None:
-                Mb = self.mobility.near_field_blocks(np.zeros((self.nb, 3)), 0) / self.machin
-                cached = self._local_blocks = (Mb, 1.0 / (self.machin * self.rot_drag[self.ec:]))
-            return cached
+            Mb = self.__dict__.get("_local_blocks")
+            if Mb is None:
+                Mb = self._local_blocks = (
+                    self.mobility.near_field_blocks(np.zeros((self.nb, 3)), 0) / self.machin)
+            return Mb, self.twist_mobility
         x, _, _ = self.unpack(y)
         Mb = self.mobility.near_field_blocks(x[self.nc:], width)
         Mb /= self.machin
-        return Mb, 1.0 / (self.machin * self.rot_drag[self.ec:])
+        return Mb, self.twist_mobility
 
     def mobility_blocks(self, y: np.ndarray):
         """``Mob`` as its two non-zero blocks: dense translational (3nb, 3nb), twist diagonal (ne,)."""
         x, _, _ = self.unpack(y)
         Mxx = self.mobility.matrix(x[self.nc:])
         Mxx /= self.machin
-        return Mxx, 1.0 / (self.machin * self.rot_drag[self.ec:])
+        return Mxx, self.twist_mobility
 
     def mobility_matrix(self, y: np.ndarray) -> np.ndarray:
         """Dense ``Mob(y)`` (ny, ny)."""
@@ -225,7 +226,7 @@ class RodSystem:
         n3 = 3 * self.nb
         Mob[:n3, :n3] = self.mobility.matrix(x[self.nc:]) / self.machin
         idx = np.arange(n3, n3 + self.ne)
-        Mob[idx, idx] = 1.0 / (self.machin * self.rot_drag[self.ec:])
+        Mob[idx, idx] = self.twist_mobility
         return Mob
 
     # Jacobian by coloured finite differences ------------------------------------------------
