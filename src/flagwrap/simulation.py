@@ -23,6 +23,8 @@ reproduces the uninterrupted run bit for bit (the state includes the step-size c
 from __future__ import annotations
 
 import math
+import signal
+import threading
 import time as _time
 from dataclasses import dataclass, field
 
@@ -213,8 +215,14 @@ class Simulation:
         last_ck = start
         fixed = not self.integrator.adaptive
         eps = 1e-12 * max(1.0, t_end)
+        interrupted = _deferred_sigint()
         try:
             while t < t_end - eps:
+                if interrupted():
+                    # between steps the state is consistent: keep it as the last frame
+                    if traj.t[-1] < t - eps:
+                        self._record(traj, t, y, info, sched(t - eps))
+                    raise KeyboardInterrupt
                 k = sched.segment_index(t + eps)
                 seg = sched.segments[k]
                 omega = seg.omega
@@ -274,8 +282,9 @@ class Simulation:
             traj.message = str(stop)
         except KeyboardInterrupt:
             # keep what was computed, but still stop the caller (a sweep, a notebook): the
-            # exception carries the saved frames (the state mid-step may be half-updated, so
-            # it is not appended; at most save_every of motion is lost)
+            # exception carries the saved frames. A first Ctrl-C is deferred to the end of the
+            # step (then the state is appended); a second one lands mid-step, where the state
+            # may be half-updated, so it is not appended (at most save_every of motion lost)
             traj.status = "failed"
             traj.message = f"t/T={t / TWO_PI:.6g}: interrupted (SIGINT / Ctrl-C)"
             traj.wall_time = wall0 + _time.perf_counter() - start
@@ -284,6 +293,7 @@ class Simulation:
                 bar.close()
             raise RunInterrupted(traj) from None
         finally:
+            interrupted.restore()
             if bar is not None:
                 bar.close()
             traj.wall_time = wall0 + _time.perf_counter() - start
@@ -293,6 +303,39 @@ class Simulation:
 
 class _Stop(Exception):
     pass
+
+
+class _deferred_sigint:
+    """Turn the first SIGINT during a run into a flag the time loop checks between steps.
+
+    Why: a KeyboardInterrupt raised inside a numba kernel (or while numba loads one from its
+    cache) surfaces as a ``SystemError``, not a KeyboardInterrupt, so the run would die with a
+    traceback instead of keeping its frames. The handler puts the previous one back, so a second
+    Ctrl-C interrupts at once (a step can take seconds at large N). Installed only in the main
+    thread (Python allows signal handlers nowhere else); elsewhere the flag stays down.
+    """
+
+    def __init__(self):
+        self.flag = False
+        self.previous = None
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.getsignal(signal.SIGINT)
+            if self.previous is signal.default_int_handler:
+                signal.signal(signal.SIGINT, self._handle)
+            else:  # someone else (a notebook kernel, a test runner) owns SIGINT: leave it
+                self.previous = None
+
+    def _handle(self, signum, frame):
+        self.flag = True
+        self.restore()
+
+    def restore(self):
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+            self.previous = None
+
+    def __call__(self) -> bool:
+        return self.flag
 
 
 class RunInterrupted(KeyboardInterrupt):

@@ -169,3 +169,57 @@ def test_ctrl_c_keeps_a_readable_partial_run_file(tmp_path):
     ds = read_run(out)
     assert ds.attrs["status"] == "failed" and "interrupted" in ds.attrs["message"]
     assert len(ds["time"]) >= 1 and np.all(np.isfinite(ds["position"].values))
+
+
+def _interrupting_step(sim, n_signals, after=3):
+    """Wrap ``sim.integrator.step`` so that its ``after``-th call sends ``n_signals`` SIGINTs to
+    this process from inside the step, like a Ctrl-C landing mid-step."""
+    import signal
+
+    inner, calls = sim.integrator.step, [0]
+
+    def step(*args, **kwargs):
+        calls[0] += 1
+        if calls[0] == after:
+            for _ in range(n_signals):
+                signal.raise_signal(signal.SIGINT)
+        return inner(*args, **kwargs)
+
+    sim.integrator.step = step
+    return calls
+
+
+def test_first_ctrl_c_finishes_the_step_and_keeps_its_state():
+    """One SIGINT mid-step is deferred to the step's end: the run stops there with the state
+    after that step as its last frame, and Python's own SIGINT handler is back afterwards."""
+    import signal
+
+    from flagwrap.simulation import RunInterrupted
+
+    sim = Simulation(_cfg())
+    calls = _interrupting_step(sim, 1)
+    with pytest.raises(RunInterrupted) as exc:
+        sim.run()
+    traj = exc.value.trajectory
+    assert calls[0] == 3  # no step started after the signal
+    assert traj.status == "failed" and "interrupted" in traj.message
+    assert traj.n_steps + traj.n_rejected == 3
+    assert traj.t[-1] > 0 and np.all(np.isfinite(traj.arrays()["x"]))
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_second_ctrl_c_interrupts_inside_the_step():
+    """A second SIGINT is not deferred (a step may take seconds at large N): the step is cut,
+    and the frames saved before it are kept."""
+    import signal
+
+    from flagwrap.simulation import RunInterrupted
+
+    sim = Simulation(_cfg())
+    _interrupting_step(sim, 2)
+    with pytest.raises(RunInterrupted) as exc:
+        sim.run()
+    traj = exc.value.trajectory
+    assert traj.n_steps + traj.n_rejected == 2  # the third step never finished
+    assert len(traj.t) >= 1 and traj.t[0] == 0.0
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
