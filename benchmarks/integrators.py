@@ -12,7 +12,7 @@ Measured in one process, on one core (BLAS limited to one thread):
 4. the Euler reference and a converged ROS2 solution agree over the Euler window;
 5. the fast stepper over the full protocol with the hydrodynamic interactions off.
 
-Prints wall seconds per simulated motor turn for both and ``ratio: X`` = Euler / ROS2.
+Prints wall seconds per simulated motor turn for both and ``ratio: X`` = Euler / ROS34PW2 (the default stepper of 2).
 ``--quick`` runs 2 + 2 turns instead of 10 + 10 (for a smoke test of the script).
 """
 

@@ -17,9 +17,11 @@ For N = 61, 250, 1000, 4000, 16000:
   size from the controller, after untimed warm-up steps) with each stage solver: ``dense``
   (exact LU, N <= 1000), ``krylov`` (matrix-free GCR to rtol 1e-3 and 0.1 x the step tolerance per unknown, recycling across
   stages, banded near-field preconditioner; the default above 400 unknowns), ``near``
-  (near-field W-method, one banded LU, O(N)): wall time per attempted step, accepted
-  fraction and simulated motor turns per wall hour (the throughput that matters: the near
-  W-method's cheap steps are short ones);
+  (near-field W-method, one banded LU, O(N)); and ROS2 with the GCR solver (``ros2 krylov``,
+  same tolerance 1e-5: on long chains its step is several times ROS34PW2's at a larger
+  error, benchmarks/long_chain.py compares them at equal accuracy): wall time per attempted
+  step, accepted fraction and simulated motor turns per wall hour (the throughput that
+  matters: the near W-method's cheap steps are short ones);
 * peak traced memory (tracemalloc: numpy buffers) of one ``krylov`` step, to show O(N).
 
 Prints a table, the crossover N where FMM beats the direct sum (if any), and the steps per
@@ -38,9 +40,12 @@ from threadpoolctl import threadpool_limits
 from flagwrap.cases import get_case
 from flagwrap.hydrodynamics.mobility import (FMMMobility, JAXMobility, RPYMobility,
                                              backend_missing)
-from flagwrap.integrators.ros34pw2 import ROS34PW2
+from flagwrap.integrators import make_integrator
 from flagwrap.model import RodSystem
 from flagwrap.params import Filament
+
+
+STEPPERS = ("dense", "krylov", "near", "ros2 krylov")  # ROS34PW2 with each solver, then ROS2
 
 
 def system_for(N):
@@ -62,11 +67,11 @@ def best_of(fn, repeat):
     return best
 
 
-def run_steps(s, kind, nstep, warm, trace=False):
+def run_steps(s, kind, nstep, warm, trace=False, integrator="ros34pw2"):
     """``warm`` untimed steps (compilation, start-up transient), then ``nstep`` timed ones:
     (wall per attempted step, accepted fraction, turns per wall hour, peak traced memory of
     one more step or None)."""
-    integ = ROS34PW2(tol=1e-5, linear_solver=kind)
+    integ = make_integrator(integrator, 1e-5, kind)
     y = s.initial_y()
     info = s.forces(y, s.frames0)
     h = 1e-3 * 2 * np.pi
@@ -137,13 +142,17 @@ def main():
                 line.append(f"{name} {t * 1e3:.3f} ms (rel.err {err:.0e})")
             print("  ".join(line), flush=True)
             line = ["          step:"]
-            for kind in ("dense", "krylov", "near"):
+            for kind in STEPPERS:
                 if kind == "dense" and N > 1000:
                     continue  # O(N^2) memory, O(N^3) time
+                if kind == "ros2 krylov" and N > 4000:
+                    continue  # the same products as krylov; N = 16000 takes minutes per step
                 # the controller needs ~10 steps to shrink the first step (1e-3 turn) to what long
                 # chains take at the start, hence the warm-up counts
                 nstep, warm = (40, 10) if N <= 1000 else ((10, 10) if N <= 4000 else (4, 10))
-                t, acc, tph, peak = run_steps(s, kind, nstep, warm, trace=(kind == "krylov"))
+                integ, solver = ("ros2", "krylov") if kind == "ros2 krylov" else ("ros34pw2", kind)
+                t, acc, tph, peak = run_steps(s, solver, nstep, warm, trace=(kind == "krylov"),
+                                              integrator=integ)
                 steps[(N, kind)] = (t, peak)
                 line.append(f"{kind} {t:.4f} s (acc {acc:.2f}, {tph:.3g} turns/h"
                             + (f", peak {peak / 1e6:.1f} MB)" if peak else ")"))
@@ -154,7 +163,7 @@ def main():
               f"never up to N = {sizes[-1]}")
     if any(k[0] == 1000 for k in steps):
         print("N = 1000 steps/s: " + ", ".join(f"{kind} {1 / steps[(1000, kind)][0]:.2f}"
-                                                for kind in ("dense", "krylov", "near")
+                                                for kind in STEPPERS
                                                 if (1000, kind) in steps))
     mem = {n: p for (n, k), (_, p) in steps.items() if p}
     big = sorted(n for n in mem if n >= 1000)
