@@ -174,12 +174,14 @@ class RodSystem:
         SK.unit_tangents(x, t)
         return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist)
 
-    def apply_mobility(self, y: np.ndarray, G: np.ndarray) -> np.ndarray:
-        """``Mob(y) G`` without the motor term."""
+    def apply_mobility(self, y: np.ndarray, G: np.ndarray, single: bool = False) -> np.ndarray:
+        """``Mob(y) G`` without the motor term; ``single``: to ~1e-6 relative
+        (:meth:`Mobility.apply_single`), for the products inside an iterative solve."""
         out = np.empty_like(G)
         x, _, _ = self.unpack(y)
         Fx = G[self.sl_x].reshape(-1, 3)
-        out[self.sl_x] = self.mobility.apply(x[self.nc:], Fx).ravel() / self.machin
+        apply = self.mobility.apply_single if single else self.mobility.apply
+        out[self.sl_x] = apply(x[self.nc:], Fx).ravel() / self.machin
         out[self.sl_th] = G[self.sl_th] / (self.machin * self.rot_drag[self.ec:])
         out[-1] = 0.0
         return out

@@ -96,6 +96,28 @@ def _chain(n, seed=3):
     return x, a, rng.standard_normal((n, 3))
 
 
+def test_single_precision_product_is_accurate_to_float32_rounding():
+    """``apply_single`` (float32 pair loop, for GCR's operator products) against the dense
+    float64 product. Bound: a separation carries float32 rounding (6e-8) x (distance from the
+    centre / separation); this chain is ~60 bonds wide, so ~4e-6 per near pair at worst; the
+    norm-wise error must stay below 2e-5, and must be nonzero (the float32 path is taken)."""
+    from flagwrap.hydrodynamics import _kernels as K
+
+    x, a, F = _chain(K.SYMMETRIC_MIN_N + 500)
+    mob = RPYMobility(a)
+    ref = (mob.matrix(x) @ F.ravel()).reshape(-1, 3)
+    out = mob.apply_single(x, F)
+    err = np.linalg.norm(out - ref) / np.linalg.norm(ref)
+    assert 1e-12 < err < 2e-5
+    assert np.max(np.abs(out - ref)) < 2e-5 * np.max(np.abs(ref))
+    # where the float64 product is not the pair loop, the single product is the exact one
+    xs, as_, Fs = _chain(K.SYMMETRIC_MIN_N - 1)
+    np.testing.assert_array_equal(RPYMobility(as_).apply_single(xs, Fs),
+                                  RPYMobility(as_).apply(xs, Fs))
+    np.testing.assert_array_equal(RPYMobility(a, threads=2).apply_single(x, F),
+                                  RPYMobility(a, threads=2).apply(x, F))
+
+
 def test_threaded_direct_product_agrees_to_rounding():
     from flagwrap.hydrodynamics.mobility import RPYMobility
 

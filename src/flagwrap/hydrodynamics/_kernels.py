@@ -63,23 +63,37 @@ def rpy_matrix(x, a, out):
 
 @nb.njit(cache=True, inline="always")
 def _rpy_constants(a):
-    """(s, c8, aa, four_aa, kn, kg, floor): the per-radius constants of the pair loops."""
+    """(s, c8, aa, four_aa, kn, kg, floor, one, two_thirds, two): the per-radius constants of
+    the pair loops, float64."""
     aa = a * a
     return (1.0 / (6.0 * math.pi * a), 1.0 / (8.0 * math.pi), aa, 4.0 * aa,
-            9.0 / (32.0 * a), 3.0 / (32.0 * a), 1e-32 * aa)
+            9.0 / (32.0 * a), 3.0 / (32.0 * a), 1e-32 * aa, 1.0, 2.0 / 3.0, 2.0)
 
 
-def _rpy_pair_coefficients(r2, s, c8, aa, four_aa, kn, kg, floor):
+@nb.njit(cache=True, inline="always")
+def _rpy_constants32(a):
+    """The same constants as float32, for :func:`rpy_apply_single` (float32 literals: a float64
+    one would promote the whole loop back to float64)."""
+    s, c8, aa, four_aa, kn, kg, floor, one, two_thirds, two = _rpy_constants(a)
+    f4 = np.float32
+    return (f4(s), f4(c8), f4(aa), f4(four_aa), f4(kn), f4(kg), f4(max(floor, 1e-30)), f4(one),
+            f4(two_thirds), f4(two))
+
+
+def _rpy_pair_coefficients(r2, c):
     """(f, g) with mu_hat_ij = f I + g d d (d = x_i - x_j, r2 = |d|^2), branch-free form of
-    :func:`_pair` (see :func:`_rpy_gather_rows`)."""
+    :func:`_pair` (see :func:`_rpy_gather_rows`). ``c``: the constants of
+    :func:`_rpy_constants`, numeric literals included, so that one function serves float64
+    and float32 (numba compiles one version per type)."""
+    s, c8, aa, four_aa, kn, kg, floor, one, two_thirds, two = c
     r2 = max(r2, floor)
-    ir = 1.0 / math.sqrt(r2)
+    ir = one / math.sqrt(r2)
     ir2 = ir * ir
     cf = c8 * ir
     q = aa * ir2
     far = r2 >= four_aa
-    f = cf * (1.0 + (2.0 / 3.0) * q) if far else s * (1.0 - kn * r2 * ir)
-    g = cf * (1.0 - 2.0 * q) * ir2 if far else s * kg * ir
+    f = cf * (one + two_thirds * q) if far else s * (one - kn * r2 * ir)
+    g = cf * (one - two * q) * ir2 if far else s * kg * ir
     return f, g
 
 
@@ -98,7 +112,7 @@ def _rpy_gather_rows(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, i0, i1):
     (r = 0) takes the overlap branch, whose value at r = 0 is exactly the self mobility
     ``1/(6 pi a)``; ``r^2`` is floored at ``1e-32 a^2`` (the self term is then exact to 3e-17, and no term overflows).
     """
-    s, c8, aa, four_aa, kn, kg, floor = _rpy_constants(a)
+    c = _rpy_constants(a)
     n = xs.shape[0]
     for i in range(i0, i1):
         xi = xs[i]
@@ -111,7 +125,7 @@ def _rpy_gather_rows(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, i0, i1):
             d0 = xi - xs[j]
             d1 = yi - ys[j]
             d2 = zi - zs[j]
-            f, g = _coef(d0 * d0 + d1 * d1 + d2 * d2, s, c8, aa, four_aa, kn, kg, floor)
+            f, g = _coef(d0 * d0 + d1 * d1 + d2 * d2, c)
             fxj = fx[j]
             fyj = fy[j]
             fzj = fz[j]
@@ -160,20 +174,20 @@ def _rpy_apply_serial(x, a, F, out):
 
 
 @nb.njit(cache=True, fastmath=True, error_model="numpy")
-def _sym_row(xi, yi, zi, fxi, fyi, fzi, bx, by, bz, bfx, bfy, bfz, tx, ty, tz,
-             s, c8, aa, four_aa, kn, kg, floor):
+def _sym_row(xi, yi, zi, fxi, fyi, fzi, bx, by, bz, bfx, bfy, bfz, tx, ty, tz, c):
     """Pairs of bead i with a block of beads, both ways: returns the sum on i and adds the
     transposed terms to the block's accumulators ``t``. The block arrays are slices passed
     to a separate function, so LLVM vectorises the loop despite the store to ``t[j]``
-    (measured: inlined into the caller it ran 2x slower than the gather loop)."""
-    a0 = 0.0
-    a1 = 0.0
-    a2 = 0.0
+    (measured: inlined into the caller it ran 2x slower than the gather loop). ``c``: the
+    constants of :func:`_rpy_constants` (or ``32``); the sums keep their precision."""
+    a0 = c[0] - c[0]  # zero of the working precision
+    a1 = a0
+    a2 = a0
     for j in range(bx.shape[0]):
         d0 = xi - bx[j]
         d1 = yi - by[j]
         d2 = zi - bz[j]
-        f, g = _coef(d0 * d0 + d1 * d1 + d2 * d2, s, c8, aa, four_aa, kn, kg, floor)
+        f, g = _coef(d0 * d0 + d1 * d1 + d2 * d2, c)
         fxj = bfx[j]
         fyj = bfy[j]
         fzj = bfz[j]
@@ -189,17 +203,15 @@ def _sym_row(xi, yi, zi, fxi, fyi, fzi, bx, by, bz, bfx, bfy, bfz, tx, ty, tz,
 
 
 @nb.njit(cache=True, fastmath=True, error_model="numpy")
-def _rpy_apply_sym(x, a, F, out, block):
-    """``out = mu_hat F`` visiting each pair once (i < j), by column blocks of ``block``
-    beads: half the pair evaluations of the gather loop, ~1.5x faster from N ~ 250 (measured
-    N = 1000: 0.94 vs 1.41 ms; 16000: 220 vs 361 ms). Serial only."""
-    n = x.shape[0]
-    xs, ys, zs, fx, fy, fz = _soa(x, F)
-    s, c8, aa, four_aa, kn, kg, floor = _rpy_constants(a)
+def _sym_sums(xs, ys, zs, fx, fy, fz, c, block):
+    """``mu_hat F`` (structure of arrays, in the precision of the inputs and ``c``) visiting
+    each pair once (i < j), by column blocks of ``block`` beads."""
+    n = xs.shape[0]
+    s = c[0]
     ox = s * fx
     oy = s * fy
     oz = s * fz
-    tx, ty, tz = np.empty(block), np.empty(block), np.empty(block)
+    tx, ty, tz = np.empty(block, xs.dtype), np.empty(block, xs.dtype), np.empty(block, xs.dtype)
     for j0 in range(0, n, block):
         j1 = min(n, j0 + block)
         m = j1 - j0
@@ -211,15 +223,60 @@ def _rpy_apply_sym(x, a, F, out, block):
             a0, a1, a2 = _sym_row(xs[i], ys[i], zs[i], fx[i], fy[i], fz[i],
                                   xs[j0 + lo:j1], ys[j0 + lo:j1], zs[j0 + lo:j1],
                                   fx[j0 + lo:j1], fy[j0 + lo:j1], fz[j0 + lo:j1],
-                                  tx[lo:m], ty[lo:m], tz[lo:m],
-                                  s, c8, aa, four_aa, kn, kg, floor)
+                                  tx[lo:m], ty[lo:m], tz[lo:m], c)
             ox[i] += a0
             oy[i] += a1
             oz[i] += a2
         ox[j0:j1] += tx[:m]
         oy[j0:j1] += ty[:m]
         oz[j0:j1] += tz[:m]
+    return ox, oy, oz
+
+
+@nb.njit(cache=True, fastmath=True, error_model="numpy")
+def _rpy_apply_sym(x, a, F, out, block):
+    """``out = mu_hat F`` visiting each pair once (i < j), by column blocks of ``block``
+    beads: half the pair evaluations of the gather loop, ~1.5x faster from N ~ 250 (measured
+    N = 1000: 0.94 vs 1.41 ms; 16000: 220 vs 361 ms). Serial only."""
+    xs, ys, zs, fx, fy, fz = _soa(x, F)
+    ox, oy, oz = _sym_sums(xs, ys, zs, fx, fy, fz, _rpy_constants(a), block)
     _aos(ox, oy, oz, out)
+
+
+@nb.njit(cache=True, fastmath=True, error_model="numpy")
+def rpy_apply_single(x, a, F, out, block):
+    """``out = mu_hat F`` (float64 in and out) computed in float32: the pair loop of
+    :func:`_rpy_apply_sym` with twice the SIMD lanes, ~1.9x faster (measured N = 1000: 0.48
+    vs 0.89 ms; 4000: 6.4 vs 13.2 ms).
+
+    For the products inside an iterative solve that stops at a relative residual of 1e-3,
+    not for the right-hand side. Accuracy: positions are centred before the cast, so the
+    separation of two beads carries a relative rounding error of ~6e-8 (float32 epsilon)
+    x (chain extent / separation); measured 7e-7 relative (1.4e-6 largest component) on the
+    1000-bead chain of benchmarks/scaling.py, 3e-6 at 4000.
+    """
+    n = x.shape[0]
+    c0 = x[:, 0].mean()
+    c1 = x[:, 1].mean()
+    c2 = x[:, 2].mean()
+    xs = np.empty(n, np.float32)
+    ys = np.empty(n, np.float32)
+    zs = np.empty(n, np.float32)
+    fx = np.empty(n, np.float32)
+    fy = np.empty(n, np.float32)
+    fz = np.empty(n, np.float32)
+    for i in range(n):
+        xs[i] = x[i, 0] - c0
+        ys[i] = x[i, 1] - c1
+        zs[i] = x[i, 2] - c2
+        fx[i] = F[i, 0]
+        fy[i] = F[i, 1]
+        fz[i] = F[i, 2]
+    ox, oy, oz = _sym_sums(xs, ys, zs, fx, fy, fz, _rpy_constants32(a), block)
+    for i in range(n):
+        out[i, 0] = ox[i]
+        out[i, 1] = oy[i]
+        out[i, 2] = oz[i]
 
 
 SYMMETRIC_MIN_N = 256  # below it the gather loop wins (N = 61: 0.007 vs 0.012 ms)

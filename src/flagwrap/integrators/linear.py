@@ -132,7 +132,9 @@ class KrylovW:
         self.iterations = 0
 
     def matvec(self, v):
-        return v - self.gh * self.system.apply_mobility(self.y, self.J @ v)
+        # single precision (~1e-6 relative, ~1.9x faster from N = 256): far below the 1e-3
+        # the solve stops at; measured N = 1000: 53-55 -> 43 ms per step, turns per hour +14 %
+        return v - self.gh * self.system.apply_mobility(self.y, self.J @ v, single=True)
 
     def _converged(self, r, z, bn):
         if float(np.linalg.norm(r)) > self.rtol * bn:
