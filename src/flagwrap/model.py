@@ -175,7 +175,7 @@ class RodSystem:
         return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist)
 
     def apply_mobility(self, y: np.ndarray, G: np.ndarray, single: bool = False) -> np.ndarray:
-        """``Mob(y) G`` without the motor term; ``single``: to ~1e-6 relative
+        """``Mob(y) G`` without the motor term; ``single``: to float32 accuracy
         (:meth:`Mobility.apply_single`), for the products inside an iterative solve."""
         out = np.empty_like(G)
         x, _, _ = self.unpack(y)

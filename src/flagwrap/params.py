@@ -397,8 +397,8 @@ class Numerics:
         solver of the Rosenbrock stage equations (:mod:`flagwrap.integrators.linear`): exact
         dense LU, banded LU of the near-field ``W`` (a W-method approximation, O(N)), GCR
         (matrix-free, banded near-field preconditioner, recycled across stages, operator
-        products in float32 from 256 beads; to rtol 1e-3 and 0.1 x the step tolerance per
-        unknown), or exact banded / sparse LU (HI off only). "auto":
+        products in float32 from 256 beads with the direct backend and one thread; to rtol
+        1e-3 and 0.1 x the step tolerance per unknown), or exact banded / sparse LU (HI off only). "auto":
         banded with HI off; with HI dense up to 400 unknowns (N ~ 100), GCR above (measured
         crossover).
     dt_min : float

@@ -34,6 +34,9 @@ from flagwrap.integrators import make_integrator
 from flagwrap.model import RodSystem
 
 TWO_PI = 2.0 * math.pi
+# the per-frame records of a Trajectory, in the order Simulation._record computes them
+_RECORDS = ("t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
+            "contact_energy", "min_distance", "max_strain")
 
 
 @dataclass
@@ -64,9 +67,7 @@ class Trajectory:
         return self.status == "completed"
 
     def arrays(self) -> dict:
-        return {k: np.asarray(getattr(self, k)) for k in (
-            "t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
-            "contact_energy", "min_distance", "max_strain")}
+        return {k: np.asarray(getattr(self, k)) for k in _RECORDS}
 
 
 class Simulation:
@@ -98,22 +99,19 @@ class Simulation:
 
     def _record(self, traj, t, y, info, omega):
         s = self.system
-        traj.t.append(t)
-        traj.x.append(info.x.copy())
-        traj.theta.append(info.theta.copy())
         m1 = np.empty((s.N - 1, 3))
         m2 = np.empty((s.N - 1, 3))
         from flagwrap.elasticity._kernels import material_frames
 
         material_frames(info.frames.t, info.frames.d1, info.theta, m1, m2)
-        traj.m1.append(m1)
-        traj.phi.append(y[-1])
-        traj.omega.append(omega)
-        traj.motor_torque.append(s.motor_torque(info, y[-1], omega))
-        traj.elastic_energy.append(info.elastic_energy)
-        traj.contact_energy.append(info.contact_energy)
-        traj.min_distance.append(float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf)
-        traj.max_strain.append(self._strain(info))
+        # everything computed before anything is appended: an interrupt in between must not
+        # leave the records with different lengths
+        row = (t, info.x.copy(), info.theta.copy(), m1, y[-1], omega,
+               s.motor_torque(info, y[-1], omega), info.elastic_energy, info.contact_energy,
+               float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf,
+               self._strain(info))
+        for name, value in zip(_RECORDS, row):
+            getattr(traj, name).append(value)
 
     def _strain(self, info) -> float:
         ln = np.linalg.norm(np.diff(info.x, axis=0), axis=1)
@@ -280,7 +278,9 @@ class Simulation:
         except _Stop as stop:
             traj.status = "failed"
             traj.message = str(stop)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, SystemError) as exc:
+            if isinstance(exc, SystemError) and not _caused_by_interrupt(exc):
+                raise
             # keep what was computed, but still stop the caller (a sweep, a notebook): the
             # exception carries the saved frames. A first Ctrl-C is deferred to the end of the
             # step (then the state is appended); a second one lands mid-step, where the state
@@ -298,7 +298,25 @@ class Simulation:
                 bar.close()
             traj.wall_time = wall0 + _time.perf_counter() - start
             traj.final_frames = base
+        if interrupted():
+            # the Ctrl-C came during the last step, or one a guard stopped: the run ended by
+            # itself, but the caller asked to stop (a sweep must not go on to the next case)
+            note = "interrupted (SIGINT / Ctrl-C) during the last step"
+            traj.message = f"{traj.message}; {note}" if traj.message else note
+            raise RunInterrupted(traj)
         return traj
+
+
+def _caused_by_interrupt(exc) -> bool:
+    """Whether ``exc`` wraps a KeyboardInterrupt: numba turns one raised while it loads or
+    runs compiled code into ``SystemError`` (the chain keeps the original)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 class _Stop(Exception):
@@ -320,9 +338,12 @@ class _deferred_sigint:
         self.previous = None
         if threading.current_thread() is threading.main_thread():
             self.previous = signal.getsignal(signal.SIGINT)
-            if self.previous is signal.default_int_handler:
+            if self.previous is not signal.default_int_handler:
+                self.previous = None  # someone else owns SIGINT (a test runner, a GUI): leave it
+                return
+            try:
                 signal.signal(signal.SIGINT, self._handle)
-            else:  # someone else (a notebook kernel, a test runner) owns SIGINT: leave it
+            except ValueError:  # the main thread of a sub-interpreter may not set handlers
                 self.previous = None
 
     def _handle(self, signum, frame):

@@ -173,9 +173,12 @@ def test_ctrl_c_keeps_a_readable_partial_run_file(tmp_path):
 
 def _interrupting_step(sim, n_signals, after=3):
     """Wrap ``sim.integrator.step`` so that its ``after``-th call sends ``n_signals`` SIGINTs to
-    this process from inside the step, like a Ctrl-C landing mid-step."""
+    this process from inside the step, like a Ctrl-C landing mid-step (``raise_signal`` runs
+    the Python handler synchronously, in this thread)."""
     import signal
 
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("the test runner owns SIGINT here")
     inner, calls = sim.integrator.step, [0]
 
     def step(*args, **kwargs):
@@ -221,5 +224,50 @@ def test_second_ctrl_c_interrupts_inside_the_step():
         sim.run()
     traj = exc.value.trajectory
     assert traj.n_steps + traj.n_rejected == 2  # the third step never finished
-    assert len(traj.t) >= 1 and traj.t[0] == 0.0
+    assert traj.t == [0.0]  # no frame from the cut step (nor from the two before: save_every)
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_ctrl_c_in_the_last_step_still_reaches_the_caller():
+    """A deferred Ctrl-C that arrives during the step that ends the run must not be lost: the
+    run is complete (all frames kept), but the caller (a sweep) is told to stop."""
+    from flagwrap.simulation import RunInterrupted
+
+    probe = Simulation(_cfg())
+    calls = _interrupting_step(probe, 0)  # count the steps of the run (deterministic)
+    probe.run(t_end=0.01)
+    last = calls[0]
+    sim = Simulation(_cfg())
+    _interrupting_step(sim, 1, after=last)
+    with pytest.raises(RunInterrupted) as exc:
+        sim.run(t_end=0.01)
+    traj = exc.value.trajectory
+    assert traj.status == "completed" and "during the last step" in traj.message
+    assert traj.t[-1] == pytest.approx(0.01)
+
+
+def test_interrupt_wrapped_by_numba_is_still_an_interrupt():
+    """numba reports a KeyboardInterrupt raised while it loads a cached kernel as a
+    SystemError (the CI failure this guards against); the run must treat it as Ctrl-C."""
+    from flagwrap.simulation import RunInterrupted
+
+    sim = Simulation(_cfg())
+    inner, calls = sim.integrator.step, [0]
+
+    def step(*args, **kwargs):
+        calls[0] += 1
+        if calls[0] == 3:
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt as ki:
+                raise SystemError("CPUDispatcher(...) returned a result with an exception set") from ki
+        return inner(*args, **kwargs)
+
+    sim.integrator.step = step
+    with pytest.raises(RunInterrupted) as exc:
+        sim.run()
+    assert "interrupted" in exc.value.trajectory.message
+    other = Simulation(_cfg())
+    other.integrator.step = lambda *a, **k: (_ for _ in ()).throw(SystemError("genuine"))
+    with pytest.raises(SystemError, match="genuine"):  # a real SystemError is not swallowed
+        other.run()

@@ -99,7 +99,7 @@ def _chain(n, seed=3):
 def test_single_precision_product_is_accurate_to_float32_rounding():
     """``apply_single`` (float32 pair loop, for GCR's operator products) against the dense
     float64 product. Bound: a separation carries float32 rounding (6e-8) x (distance from the
-    centre / separation); this chain is ~60 bonds wide, so ~4e-6 per near pair at worst; the
+    centre / separation); this chain is ~110 bonds wide, so ~7e-6 per near pair at worst; the
     norm-wise error must stay below 2e-5, and must be nonzero (the float32 path is taken)."""
     from flagwrap.hydrodynamics import _kernels as K
 

@@ -95,9 +95,9 @@ class KrylovW:
     and then iterates only on what is left (recycling, as in GCRO: Parks et al., SIAM J.
     Sci. Comput. 28, 1651, 2006).
 
-    ``Mob`` inside the iterations is the single-precision product (~1e-6 relative,
+    ``Mob`` inside the iterations is the single-precision product (1e-6 to 1e-5 relative,
     :meth:`~flagwrap.hydrodynamics.mobility.Mobility.apply_single`): the solve is then one of a
-    ``W`` perturbed by ~1e-6, which a W-method tolerates, at ~1.9x less cost per product.
+    ``W`` perturbed by that much, which a W-method tolerates, at ~1.9x less cost per product.
 
     Stopping rule, both: relative residual ``rtol = 1e-3`` (the recursively updated residual,
     equal to the true one in exact arithmetic) and, when the integrator passes ``err_scale``
@@ -136,8 +136,8 @@ class KrylovW:
         self.iterations = 0
 
     def matvec(self, v):
-        # single precision (~1e-6 relative, ~1.9x faster from N = 256): far below the 1e-3
-        # the solve stops at; measured N = 1000: 53-55 -> 43 ms per step, turns per hour +14 %
+        # single precision (1e-6..1e-5 relative up to N = 16000, ~1.9x faster from N = 256):
+        # far below the 1e-3 the solve stops at; measured N = 1000: 53-55 -> 43 ms per step
         return v - self.gh * self.system.apply_mobility(self.y, self.J @ v, single=True)
 
     def _converged(self, r, z, bn):
