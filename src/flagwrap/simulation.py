@@ -287,11 +287,7 @@ class Simulation:
             # may be half-updated, so it is not appended (at most save_every of motion lost)
             traj.status = "failed"
             traj.message = f"t/T={t / TWO_PI:.6g}: interrupted (SIGINT / Ctrl-C)"
-            traj.wall_time = wall0 + _time.perf_counter() - start
-            traj.final_frames = base
-            if bar is not None:
-                bar.close()
-            raise RunInterrupted(traj) from None
+            raise RunInterrupted(traj) from None  # (finally: wall time, frames, progress bar)
         finally:
             interrupted.restore()
             if bar is not None:
