@@ -15,9 +15,11 @@ deviation from the reference (in L of the long chain) for each; then, for the ac
 levels 1e-3 L and 1e-4 L, the cheapest run of each method that reaches it and the ratio of
 their wall times, measured in this one run.
 
-Why: on long chains ROS34PW2's step sits at a sharp limit well below what its tolerance
-asks for (its stages blow up beyond it, docs/numerics.md), so a looser tolerance does not
-make it faster; ROS2's stages stay bounded at several times that step.
+Why: on long chains a soft twist mode of slightly negative curvature grows at ~2500/omega
+(N = 1000), and ``W`` is singular at ``gamma h = 1/lambda``. ROS34PW2 resolves the mode and
+its step stays below that point whatever the tolerance; ROS2 steps past it, damping the mode
+instead of following it (docs/numerics.md, "Long chains: what sets the step"). Which is
+better depends on the accuracy wanted, hence this comparison.
 """
 
 from __future__ import annotations
