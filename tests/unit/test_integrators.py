@@ -111,6 +111,13 @@ def test_fast_steppers_agree_with_explicit_euler_reference():
         assert np.abs(info.x - x_euler).max() < 1e-7
 
 
+def _rest_state(n_beads, hi=True):
+    """The stress-free paper filament (M = 283): (system, state, forces)."""
+    s = RodSystem(make_config(machin=283, filament=paper_filament(n_beads=n_beads), hi=hi))
+    y = s.initial_y()
+    return s, y, s.forces(y, s.frames0)
+
+
 def _kicked_state(n_beads, seed, kick=1e-4):
     """The paper filament (HI on, M = 283) with its free beads kicked by ``kick`` L at random:
     (system, the generator after the kick, state, forces)."""
@@ -205,9 +212,7 @@ def test_near_field_w_on_a_chain_shorter_than_its_near_field_is_the_exact_w():
     # is then the whole mobility and NearW must equal the dense LU
     from flagwrap.integrators.linear import NearW
 
-    s = RodSystem(make_config(machin=283, filament=paper_filament(n_beads=5)))
-    y = s.initial_y()
-    info = s.forces(y, s.frames0)
+    s, y, info = _rest_state(5)
     r = np.random.default_rng(9).standard_normal(s.ny)
     ud = DenseW(s, y, info.frames, info.G, 1e-2).solve(r)
     un = NearW(s, y, info.frames, info.G, 1e-2).solve(r)
@@ -217,9 +222,7 @@ def test_near_field_w_on_a_chain_shorter_than_its_near_field_is_the_exact_w():
 def test_banded_solver_refuses_long_range_hydrodynamics():
     from flagwrap.integrators.linear import make_w
 
-    s = RodSystem(make_config(machin=283, filament=paper_filament(n_beads=11)))
-    y = s.initial_y()
-    info = s.forces(y, s.frames0)
+    s, y, info = _rest_state(11)
     with pytest.raises(ValueError, match="hydrodynamics = false"):
         make_w("banded", s, y, info.frames, info.G, 1e-2)
 
@@ -245,10 +248,7 @@ def test_gcr_preconditioner_width_follows_the_bead_overlap():
 
 
 def test_sparse_and_dense_jacobians_agree():
-    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
-    s = RodSystem(cfg)
-    y = s.initial_y()
-    info = s.forces(y, s.frames0)
+    s, y, info = _rest_state(31)
     Jd = s.force_jacobian(y, info.frames, info.G)
     Js = s.force_jacobian_sparse(y, info.frames, info.G).toarray()
     # same triplets; only the summation order of duplicate entries differs
@@ -256,10 +256,7 @@ def test_sparse_and_dense_jacobians_agree():
 
 
 def test_sparse_solver_matches_dense_without_hydrodynamic_interactions():
-    cfg = make_config(machin=283, filament=paper_filament(n_beads=31), hi=False)
-    s = RodSystem(cfg)
-    y = s.initial_y()
-    info = s.forces(y, s.frames0)
+    s, y, info = _rest_state(31, hi=False)
     r = np.random.default_rng(5).standard_normal(s.ny)
     ud = DenseW(s, y, info.frames, info.G, 1e-2).solve(r)
     us = SparseW(s, y, info.frames, info.G, 1e-2).solve(r)
@@ -282,11 +279,8 @@ def _run_with(solver, protocol, n_beads=31, tol=1e-5):
 def test_near_field_w_method_keeps_the_stress_free_helix_still():
     # motor off (omega = 0 is not a protocol phase): integrate a relaxation of the undeformed
     # helix with the approximate W alone, 200 steps of a fixed h
-    cfg = make_config(machin=283, filament=paper_filament(n_beads=31))
-    s = RodSystem(cfg)
+    s, y, info = _rest_state(31)
     integ = ROS34PW2(tol=1e-5, linear_solver="near")
-    y = s.initial_y()
-    info = s.forces(y, s.frames0)
     x0 = info.x.copy()
     for _ in range(200):
         r = integ.step(s, y, info.frames, info, 2 * math.pi * 1e-3, 0.0)
