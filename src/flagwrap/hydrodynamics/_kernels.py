@@ -103,6 +103,13 @@ _coef = nb.njit(cache=True, fastmath=True, error_model="numpy", inline="always")
     _rpy_pair_coefficients)
 
 
+@nb.njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _pair_velocity(f, g, d0, d1, d2, F0, F1, F2):
+    """``(f I + g d d) F``: the velocity one bead's force gives another."""
+    gd = g * (d0 * F0 + d1 * F1 + d2 * F2)
+    return f * F0 + gd * d0, f * F1 + gd * d1, f * F2 + gd * d2
+
+
 def _rpy_gather_rows(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, i0, i1):
     """Rows ``i0 <= i < i1`` of ``mu_hat F`` in structure-of-arrays layout.
 
@@ -128,13 +135,10 @@ def _rpy_gather_rows(xs, ys, zs, a, fx, fy, fz, ox, oy, oz, i0, i1):
             d1 = yi - ys[j]
             d2 = zi - zs[j]
             f, g = _coef(d0 * d0 + d1 * d1 + d2 * d2, c)
-            fxj = fx[j]
-            fyj = fy[j]
-            fzj = fz[j]
-            gd = g * (d0 * fxj + d1 * fyj + d2 * fzj)
-            a0 += f * fxj + gd * d0
-            a1 += f * fyj + gd * d1
-            a2 += f * fzj + gd * d2
+            v0, v1, v2 = _pair_velocity(f, g, d0, d1, d2, fx[j], fy[j], fz[j])
+            a0 += v0
+            a1 += v1
+            a2 += v2
         ox[i] = a0
         oy[i] = a1
         oz[i] = a2
@@ -190,17 +194,14 @@ def _sym_row(xi, yi, zi, fxi, fyi, fzi, bx, by, bz, bfx, bfy, bfz, tx, ty, tz, c
         d1 = yi - by[j]
         d2 = zi - bz[j]
         f, g = _coef(d0 * d0 + d1 * d1 + d2 * d2, c)
-        fxj = bfx[j]
-        fyj = bfy[j]
-        fzj = bfz[j]
-        gd = g * (d0 * fxj + d1 * fyj + d2 * fzj)
-        a0 += f * fxj + gd * d0
-        a1 += f * fyj + gd * d1
-        a2 += f * fzj + gd * d2
-        gi = g * (d0 * fxi + d1 * fyi + d2 * fzi)  # mu_ji = mu_ij (even in d)
-        tx[j] += f * fxi + gi * d0
-        ty[j] += f * fyi + gi * d1
-        tz[j] += f * fzi + gi * d2
+        v0, v1, v2 = _pair_velocity(f, g, d0, d1, d2, bfx[j], bfy[j], bfz[j])
+        a0 += v0
+        a1 += v1
+        a2 += v2
+        v0, v1, v2 = _pair_velocity(f, g, d0, d1, d2, fxi, fyi, fzi)  # mu_ji = mu_ij (even in d)
+        tx[j] += v0
+        ty[j] += v1
+        tz[j] += v2
     return a0, a1, a2
 
 
