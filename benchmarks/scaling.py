@@ -31,6 +31,7 @@ second of each stepper at N = 1000.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 import tracemalloc
 
@@ -48,13 +49,17 @@ from flagwrap.params import Filament
 STEPPERS = ("dense", "krylov", "near", "ros2 krylov")  # ROS34PW2 with each solver, then ROS2
 
 
-def system_for(N):
+def system_for(N, **numerics):
+    """The Fig. 4(a) helix extended to N beads at the same bond; ``numerics``: fields of
+    ``Numerics`` to change (e.g. ``mobility_backend``)."""
     cfg = get_case("fig4a")
     fil = cfg.filament
     b = fil.length / (fil.n_beads - 1)
     fil = Filament(length=b * (N - 1), helix_radius=fil.helix_radius, pitch=fil.pitch,
                    cross_section_radius=fil.cross_section_radius,
                    youngs_modulus=fil.youngs_modulus, n_beads=N)
+    if numerics:
+        cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, **numerics))
     return RodSystem(cfg.replace(filament=fil))
 
 

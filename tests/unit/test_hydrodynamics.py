@@ -155,6 +155,27 @@ def test_jax_backend_agrees_with_dense():
         np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-10 * np.abs(ref).max())
 
 
+def test_jax_single_precision_product_is_accurate_to_float32_rounding():
+    """JAX's float32 product (GCR's operator products on a GPU) against the dense float64
+    product, same bound and reasoning as the numba float32 test above: nonzero (float32 is
+    really used) and below 2e-5 (float32 rounding x ~110 bonds of extent); a TF32 matrix
+    product (10-bit mantissa) would miss it by ~100x."""
+    pytest.importorskip("jax")
+    from flagwrap.hydrodynamics.mobility import JAXMobility
+
+    x, a, F = _chain(756)
+    # also at the bead radius of benchmarks/scaling.py's long chains (~1e-4 in core units),
+    # where a floor on the self pair's r^2 of 1e-32 a^2 underflows in float32 (NaN rows)
+    for scale in (1.0, 1e-4 / a):
+        xs, as_ = scale * x, scale * a
+        ref = (RPYMobility(as_).matrix(xs) @ F.ravel()).reshape(-1, 3)
+        out = JAXMobility(as_, block=256).apply_single(xs, F)
+        assert out.dtype == np.float64
+        err = np.linalg.norm(out - ref) / np.linalg.norm(ref)
+        assert 1e-12 < err < 2e-5
+        assert np.max(np.abs(out - ref)) < 2e-5 * np.max(np.abs(ref))
+
+
 def test_gpu_backend_agrees_with_dense_when_a_gpu_is_present():
     from flagwrap.hydrodynamics.mobility import JAXMobility, jax_gpu_available
 

@@ -150,22 +150,30 @@ class FMMMobility(RPYMobility):
 
 
 class JAXMobility(RPYMobility):
-    """The RPY direct sum in JAX (float64), jitted; runs on a GPU when jax has one.
+    """The RPY direct sum in JAX, jitted; runs on a GPU when jax has one.
 
     Rows are processed in blocks of ``block`` so memory stays O(block * n), not O(n^2).
+    ``apply`` is float64; ``apply_single`` (the products inside GCR) is float32 on centred
+    positions, matrix products at full float32 precision (jax's default on a GPU is TF32,
+    ~1e-3 relative: far too coarse even for a preconditioned solve's operator).
     """
 
     backend = "jax"
 
     def __init__(self, radius: float, block: int = 1024, threads: int = 1):
         super().__init__(radius, threads)
-        self._fn = _jax_rpy(float(radius), int(block))
+        self.block = int(block)
+        # one jitted function; jax traces it once per argument dtype (float64, float32)
+        self._fn = _jax_rpy(float(radius), self.block)
 
     def apply(self, x, F):
         return np.asarray(self._fn(np.asarray(x, dtype=np.float64),
-                                   np.asarray(F, dtype=np.float64)))
+                                   np.asarray(F, dtype=np.float64)), dtype=np.float64)
 
-    apply_single = Mobility.apply_single  # jax (maybe a GPU), not the direct float32 sum
+    def apply_single(self, x, F):
+        x = np.asarray(x, dtype=np.float64)
+        xc = (x - x.mean(axis=0)).astype(np.float32)  # centred: float32 resolves the bonds
+        return np.asarray(self._fn(xc, np.asarray(F, dtype=np.float32)), dtype=np.float64)
 
 
 def _jax_rpy(a: float, block: int):
@@ -174,18 +182,23 @@ def _jax_rpy(a: float, block: int):
     jax.config.update("jax_enable_x64", True)
     import jax.numpy as jnp
 
+    hi = jax.lax.Precision.HIGHEST
     s = 1.0 / (6.0 * math.pi * a)
 
     def rows(xb, x, F):
         d = xb[:, None, :] - x[None, :, :]
-        r2 = jnp.maximum(jnp.sum(d * d, axis=-1), 1e-32 * a * a)
-        ir = 1.0 / jnp.sqrt(r2)
+        r2 = jnp.sum(d * d, axis=-1)
+        # coincident beads (the self pair) get 1/r = 0: the near-field form is then exactly
+        # the self mobility in any precision (a floor on r2 underflows in float32)
+        pos = r2 > 0
+        ir = jnp.where(pos, 1.0 / jnp.sqrt(jnp.where(pos, r2, 1.0)), 0.0)
         q = a * a * ir * ir
         far = r2 >= 4.0 * a * a
         f = jnp.where(far, ir / (8 * math.pi) * (1 + 2 * q / 3), s * (1 - 9 * r2 * ir / (32 * a)))
         g = jnp.where(far, ir ** 3 / (8 * math.pi) * (1 - 2 * q), s * 3 * ir / (32 * a))
-        dF = jnp.einsum("ijk,jk->ij", d, F)
-        return f @ F + jnp.einsum("ij,ijk->ik", g * dF, d)
+        dF = jnp.einsum("ijk,jk->ij", d, F, precision=hi)
+        return jnp.matmul(f, F, precision=hi) + jnp.einsum("ij,ijk->ik", g * dF, d,
+                                                           precision=hi)
 
     @jax.jit
     def apply(x, F):
