@@ -154,8 +154,10 @@ class JAXMobility(RPYMobility):
 
     Rows are processed in blocks of ``block`` so memory stays O(block * n), not O(n^2).
     ``apply`` is float64; ``apply_single`` (the products inside GCR) is float32 on centred
-    positions, matrix products at full float32 precision (jax's default on a GPU is TF32,
-    ~1e-3 relative: far too coarse even for a preconditioned solve's operator).
+    positions, matrix products at full float32 precision: jax's default on a GPU is TF32
+    (measured on an H200: 2.9e-4 relative against 2.1e-7 at full precision), too coarse
+    for the operator of a solve stopped at 1e-3. Measured there (benchmarks/gpu.py): faster
+    than the numba sum from N = 1000, 46x (float64) / 59x (float32) at N = 64000.
     """
 
     backend = "jax"
@@ -223,7 +225,9 @@ def jax_gpu_available() -> bool:
 
 
 BACKENDS = ("auto", "direct", "fmm", "jax")
-GPU_AUTO_MIN_BEADS = 2000  # estimate, not measured here (no GPU in this project's sessions)
+# benchmarks/gpu.py on an H200 (docs/numerics.md, "GPU"): a ROS34PW2 + GCR step with jax is
+# 12 % slower than the numba sum at N = 1000 (CPU work dominates) and 2.4x faster at 4000
+GPU_AUTO_MIN_BEADS = 2000
 
 
 def backend_missing(name: str) -> str | None:
