@@ -386,7 +386,7 @@ class Numerics:
         how the RPY product ``Mob F`` is computed (:mod:`flagwrap.hydrodynamics.mobility`):
         "direct" numba O(N^2) sum, "fmm" FMM3D (needs ``fmm3dpy``), "jax" JAX direct sum
         (needs ``jax``; GPU when present). "auto": direct, or jax when jax sees a GPU and
-        N >= 2000. All agree to 1e-10 (fmm: to ``mobility_tol``).
+        N >= 1250. All agree to 1e-10 (fmm: to ``mobility_tol``).
     mobility_tol : float
         requested relative precision of the FMM backend.
     max_wall_time : float

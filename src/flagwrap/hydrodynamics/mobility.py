@@ -225,9 +225,10 @@ def jax_gpu_available() -> bool:
 
 
 BACKENDS = ("auto", "direct", "fmm", "jax")
-# benchmarks/gpu.py on an H200 (docs/numerics.md, "GPU"): a ROS34PW2 + GCR step with jax is
-# 12 % slower than the numba sum at N = 1000 (CPU work dominates) and 2.4x faster at 4000
-GPU_AUTO_MIN_BEADS = 2000
+# benchmarks/gpu.py on an H200 (docs/numerics.md, "GPU"), a ROS34PW2 + GCR step with jax
+# against the numba sum: 0.98-1.12x the time at N = 1000 (the CPU work dominates), 0.70x at
+# 1250, 0.63-0.92x at 1500, 0.42x at 4000: jax from the first N it won in every run
+GPU_AUTO_MIN_BEADS = 1250
 
 
 def backend_missing(name: str) -> str | None:
