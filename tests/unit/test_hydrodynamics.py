@@ -158,14 +158,15 @@ def test_jax_backend_agrees_with_dense():
 def test_jax_single_precision_product_is_accurate_to_float32_rounding():
     """JAX's float32 product (GCR's operator products on a GPU) against the dense float64
     product, same bound and reasoning as the numba float32 test above: nonzero (float32 is
-    really used) and below 2e-5 (float32 rounding x ~110 bonds of extent); a TF32 matrix
-    product (10-bit mantissa) would miss it by ~100x."""
+    really used) and below 2e-5 (float32 rounding x ~110 bonds of extent); TF32 matrix
+    products (jax's GPU default, 2.9e-4 on a float32 matmul on an H200) would miss it ~15x."""
     pytest.importorskip("jax")
     from flagwrap.hydrodynamics.mobility import JAXMobility
 
     x, a, F = _chain(756)
-    # also at the bead radius of benchmarks/scaling.py's long chains (~1e-4 in core units),
-    # where a floor on the self pair's r^2 of 1e-32 a^2 underflows in float32 (NaN rows)
+    # also at the bead radius of benchmarks/scaling.py's long chains (2e-4 at N = 1000, 1.4e-5
+    # at 16000, core units), where a floor on the self pair's r^2 of 1e-32 a^2 underflows in
+    # float32 (NaN rows, seen at N = 250)
     for scale in (1.0, 1e-4 / a):
         xs, as_ = scale * x, scale * a
         ref = (RPYMobility(as_).matrix(xs) @ F.ravel()).reshape(-1, 3)
