@@ -56,3 +56,26 @@ def test_bad_configs_give_one_line_errors(tmp_path, text, needle):
 def test_missing_file():
     with pytest.raises(UserInputError, match="not found"):
         load_config("does/not/exist.toml")
+
+
+_BASE = {"filament": {"length": 0.4, "helix_radius": 0.03, "turns": 2,
+                      "cross_section_radius": 0.0015, "youngs_modulus": 1.5e6},
+         "motor": {"machin": 283}}
+
+
+@pytest.mark.parametrize("section,key", [("filament", "length"), ("filament", "youngs_modulus"),
+                                         ("filament", "density"), ("fluid", "viscosity"),
+                                         ("fluid", "density")])
+def test_booleans_are_rejected_where_unit_scaled_numbers_are_expected(section, key):
+    # the [units] scaling must not turn true into 1.0 before validation sees it
+    d = {**_BASE, section: {**_BASE.get(section, {}), key: True}}
+    with pytest.raises(UserInputError, match=f"{key} must be a number"):
+        config_from_dict(d)
+
+
+def test_stored_toml_escapes_control_characters(tmp_path):
+    # a run file stores config_to_toml(cfg) as "the full input, re-loadable"
+    cfg = config_from_dict({**_BASE, "name": 'tiny\nrun\t"q" \\ \x7f\x01'})
+    p = tmp_path / "c.toml"
+    p.write_text(config_to_toml(cfg))
+    assert load_config(p).name == cfg.name

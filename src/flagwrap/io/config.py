@@ -67,6 +67,10 @@ def _check_types(section: str, cls, table: dict):
             raise UserInputError(f"{section}.{key} must be finite, got {value}")
 
 
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
 def _unit(table: dict, key: str, choices: dict, default: str) -> float:
     name = table.get(key, default)
     if not isinstance(name, str) or name not in choices:
@@ -101,19 +105,15 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
         table = data.get(section, {})
         _check_types(section, cls, table)
         table = dict(table)
-        for key in _LENGTH_KEYS.get(section, ()):
-            if isinstance(table.get(key), (int, float)) and not isinstance(table.get(key), bool):
-                table[key] = table[key] * lf
+        scale = dict.fromkeys(_LENGTH_KEYS.get(section, ()), lf)
         if section == "filament":
-            if isinstance(table.get("youngs_modulus"), (int, float)):
-                table["youngs_modulus"] = table["youngs_modulus"] * pf
-            if isinstance(table.get("density"), (int, float)):
-                table["density"] = table["density"] * df
+            scale.update(youngs_modulus=pf, density=df)
         if section == "fluid":
-            if isinstance(table.get("viscosity"), (int, float)):
-                table["viscosity"] = table["viscosity"] * vf
-            if isinstance(table.get("density"), (int, float)):
-                table["density"] = table["density"] * df
+            scale.update(viscosity=vf, density=df)
+        for key, factor in scale.items():
+            # numbers only: a bool times a factor would become a float and pass validation
+            if _is_number(table.get(key)):
+                table[key] = table[key] * factor
         if section == "motor" and "protocol" in table:
             prot = table["protocol"]
             if not isinstance(prot, list):
@@ -155,13 +155,20 @@ def load_config(path) -> Config:
     return config_from_dict(data, name=path.stem)
 
 
+_TOML_ESCAPES = {"\\": "\\\\", '"': '\\"', "\b": "\\b", "\t": "\\t", "\n": "\\n",
+                 "\f": "\\f", "\r": "\\r"}
+
+
 def _toml_value(v) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, (int, float)):
         return repr(v)
     if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        # a TOML basic string: backslash, quote and every control character escaped
+        return '"' + "".join(_TOML_ESCAPES.get(ch) or (f"\\u{ord(ch):04x}" if ord(ch) < 0x20
+                                                          or ord(ch) == 0x7F else ch)
+                             for ch in v) + '"'
     raise TypeError(type(v))
 
 
