@@ -26,6 +26,7 @@ import math
 import signal
 import threading
 import time as _time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -164,11 +165,16 @@ class Simulation:
             config_toml=self._checkpoint_toml()), self.checkpoint_path)
 
     def run(self, t_end: float | None = None, progress: bool = False, y0=None,
-            base=None, t0: float = 0.0, resume=None) -> Trajectory:
-        """Integrate from ``t0`` to ``t_end`` (default: the end of the motor protocol).
+            base=None, t0: float = 0.0, resume=None, budget_used=(0, 0.0)) -> Trajectory:
+        """Integrate from ``t0`` to ``t_end`` (default: the end of the motor protocol; beyond
+        it the motor keeps its last speed).
 
         ``resume``: a checkpoint path (or :class:`~flagwrap.io.checkpoint.Checkpoint`) to
         continue from instead of ``y0/base/t0``; it must come from the same config and version.
+        ``budget_used``: (steps, wall seconds) already spent on this run by earlier calls
+        that this one continues (a run split into chunks), counted against
+        ``numerics.max_steps`` / ``max_wall_time``; these budgets are per invocation
+        otherwise, so a run stopped by one can be resumed.
         """
         s = self.system
         sched = s.schedule
@@ -201,6 +207,9 @@ class Simulation:
             self._record(traj, t, y, info, sched(t))
             next_save = t + self.save_dt
         base = info.frames
+        n_steps0 = traj.n_steps  # the budgets count this invocation (plus budget_used)
+        steps_left = self.max_steps - int(budget_used[0])
+        wall_left = self.max_wall - float(budget_used[1])
         ck_steps, ck_secs = self.checkpoint_every_steps, self.checkpoint_every_seconds
         ck_on = self.checkpoint_path is not None and (ck_steps > 0 or ck_secs > 0)
         bar = None
@@ -224,7 +233,9 @@ class Simulation:
                 k = sched.segment_index(t + eps)
                 seg = sched.segments[k]
                 omega = seg.omega
-                stop_at = min(seg.t1, t_end, next_save)
+                # the last phase runs on to t_end (the schedule keeps its speed past its end)
+                seg_end = seg.t1 if k < len(sched.segments) - 1 else max(seg.t1, t_end)
+                stop_at = min(seg_end, t_end, next_save)
                 h_try = min(h, stop_at - t)
                 res = self.integrator.step(s, y, base, info, h_try, omega)
                 if not res.accepted:
@@ -241,10 +252,7 @@ class Simulation:
                 traj.n_steps += 1
                 t_new = t + h_try
                 msg = self._guard(res.info)
-                if msg:
-                    # keep the last good frame (every stored frame passed the guards)
-                    if traj.t[-1] < t - eps:
-                        self._record(traj, t, y, info, omega)
+                if msg:  # (t, y) stays the last good state: every stored frame passed the guards
                     raise _Stop(f"t/T={t_new / TWO_PI:.6g}: {msg}")
                 base_in = base
                 y, info = res.y, res.info
@@ -258,24 +266,34 @@ class Simulation:
                 if t >= next_save - eps:
                     self._record(traj, t, y, info, omega)
                     next_save += self.save_dt
-                if traj.n_steps >= self.max_steps:
-                    raise _Stop(f"t/T={t / TWO_PI:.6g}: reached numerics.max_steps={self.max_steps}")
-                if self.max_wall and _time.perf_counter() - start + wall0 > self.max_wall:
-                    if traj.t[-1] < t - eps:
-                        self._record(traj, t, y, info, omega)
-                    raise _Stop(f"t/T={t / TWO_PI:.6g}: wall time above numerics.max_wall_time="
-                                f"{self.max_wall:g} s")
+                over = None
+                if traj.n_steps - n_steps0 >= steps_left:
+                    over = f"reached numerics.max_steps={self.max_steps}"
+                elif self.max_wall and _time.perf_counter() - start > wall_left:
+                    over = f"wall time above numerics.max_wall_time={self.max_wall:g} s"
                 if ck_on:
                     now = _time.perf_counter()
-                    if (ck_steps > 0 and traj.n_steps % ck_steps == 0) or \
+                    if over or (ck_steps > 0 and traj.n_steps % ck_steps == 0) or \
                             (ck_secs > 0 and now - last_ck >= ck_secs):
-                        self._write_checkpoint(traj, t, t_end, y, base_in, h, next_save,
-                                               wall0 + now - start)
+                        # (at a budget stop too, so --resume goes on from exactly here)
+                        try:
+                            self._write_checkpoint(traj, t, t_end, y, base_in, h, next_save,
+                                                   wall0 + now - start)
+                        except OSError as exc:  # a full disk must not cost the computed run
+                            warnings.warn(f"checkpoint not written to {self.checkpoint_path} "
+                                          f"({exc}); the run goes on without checkpoints",
+                                          RuntimeWarning, stacklevel=2)
+                            ck_on = False
                         last_ck = _time.perf_counter()
+                if over:
+                    raise _Stop(f"t/T={t / TWO_PI:.6g}: {over}")
             if traj.t[-1] < t - eps:
                 self._record(traj, t, y, info, sched(t - eps))
             traj.status = "completed"
         except _Stop as stop:
+            # (t, y, info) is the last good state on every path to here: keep it as a frame
+            if traj.t[-1] < t - eps:
+                self._record(traj, t, y, info, sched(t - eps))
             traj.status = "failed"
             traj.message = str(stop)
         except (KeyboardInterrupt, SystemError) as exc:

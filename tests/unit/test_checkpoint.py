@@ -106,6 +106,23 @@ def test_resume_is_bit_identical_with_the_iterative_stage_solver(tmp_path):
         assert np.array_equal(A[k], B[k]), k
 
 
+def test_a_run_stopped_by_its_step_budget_resumes_with_a_larger_one(tmp_path):
+    """max_steps / max_wall_time are budgets of one invocation: the stop writes a checkpoint
+    there, resume accepts the config with a larger budget, and the result is bit-identical to
+    the uninterrupted run (the budgets do not enter the trajectory)."""
+    text = tiny_toml(ccw=0.2, cw=0.5)
+    ref = simulate(config_from_dict(tomllib.loads(text)))
+    small = config_from_dict(tomllib.loads(text.replace("[numerics]", "[numerics]\nmax_steps = 60")))
+    ck = tmp_path / "b.h5"
+    cut = simulate(small, checkpoint_path=ck, checkpoint_every_steps=1000)
+    assert cut.status == "failed" and read_checkpoint(ck).n_steps == 60
+    again = simulate(config_from_dict(tomllib.loads(text)), resume=ck)
+    assert again.status == "completed" and again.n_steps == ref.n_steps
+    A, B = ref.arrays(), again.arrays()
+    for k in A:
+        assert np.array_equal(A[k], B[k]), k
+
+
 def test_checkpoint_by_wall_time(tmp_path):
     cfg = config_from_dict(tomllib.loads(tiny_toml(ccw=0.1, cw=0.1)))
     ck = tmp_path / "s.h5"

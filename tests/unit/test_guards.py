@@ -81,6 +81,49 @@ def test_wall_time_budget_stops_the_run_and_keeps_its_frames(tmp_path):
         _cfg(max_wall_time=-1.0)
 
 
+@pytest.mark.parametrize("numerics,needle", [
+    (dict(max_steps=30), "reached numerics.max_steps=30"),
+    (dict(dt=0.002, dt_min=0.0011), "fell below dt_min=0.0011 T"),  # shrinks mid-run
+])
+def test_a_stopped_run_keeps_its_last_good_state_as_a_frame(numerics, needle):
+    # every stop path ends on a good state (t, y): it is the last frame, at the time the
+    # message names (printed to 6 digits), not the output time before it
+    traj = simulate(_cfg(**numerics))
+    assert traj.status == "failed" and needle in traj.message, traj.message
+    t_stop = float(re.match(r"t/T=([0-9.e-]+)", traj.message).group(1))
+    assert t_stop > 0.06  # past the first output times (save_every 0.05)
+    assert traj.t[-1] / (2 * np.pi) == pytest.approx(t_stop, rel=1e-5)
+
+
+def test_a_run_past_the_protocol_keeps_the_last_motor_speed():
+    # Simulation.run(t_end) beyond the protocol: the schedule keeps its last speed there
+    sim = Simulation(_cfg())
+    t_end = sim.system.schedule.t_end + 0.1 * 2 * np.pi
+    traj = sim.run(t_end=t_end)
+    assert traj.status == "completed", traj.message
+    assert traj.t[-1] == pytest.approx(t_end)
+    assert traj.omega[-1] == sim.system.schedule.segments[-1].omega
+
+
+def test_a_failed_checkpoint_write_warns_and_the_run_goes_on(tmp_path):
+    blocker = tmp_path / "not_a_folder"
+    blocker.write_text("a file where the checkpoint's folder should be")
+    with pytest.warns(RuntimeWarning, match="checkpoint not written"):
+        traj = simulate(_cfg(), checkpoint_path=blocker / "ck.h5", checkpoint_every_steps=5)
+    assert traj.status == "completed"
+    assert np.array_equal(traj.arrays()["x"], simulate(_cfg()).arrays()["x"])
+
+
+def test_run_budgets_hold_across_chunks_of_the_sweep_runner():
+    from flagwrap.analysis.critical import simulate_until_buckled
+
+    cfg = _cfg(tiny_toml(ccw=0.1, cw=3.0), max_steps=400)
+    # the CW phase runs in one-turn chunks, each a Simulation.run: 400 steps in all, not each
+    traj = simulate_until_buckled(cfg, stop_after=2.0)
+    assert traj.status == "failed" and "max_steps=400" in traj.message, traj.message
+    assert traj.n_steps == 400
+
+
 def test_non_finite_force_and_body_entry_guards_name_the_bead():
     cfg = _cfg()
     sim = Simulation(cfg)

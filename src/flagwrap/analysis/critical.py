@@ -161,7 +161,9 @@ def simulate_until_buckled(cfg, stop_after: float | None = 2.0, chunk_turns: flo
         start = _time.perf_counter()
         total, y0, base, t0 = None, None, None, 0.0
         for t1 in edges:
-            part = sim.run(t_end=t1, y0=y0, base=base, t0=t0)
+            # the run's budgets (numerics.max_steps / max_wall_time) hold for all chunks together
+            used = (total.n_steps if total is not None else 0, _time.perf_counter() - start)
+            part = sim.run(t_end=t1, y0=y0, base=base, t0=t0, budget_used=used)
             if total is None:
                 total = part
             else:

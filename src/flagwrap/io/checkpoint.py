@@ -124,6 +124,16 @@ def read_checkpoint(path) -> Checkpoint:
     return ck
 
 
+_BUDGETS = ("max_wall_time", "max_steps")
+
+
+def _without_budgets(toml_text: str) -> list[str]:
+    """Config lines without ``numerics.max_wall_time`` / ``max_steps``: budgets of one
+    invocation, which do not change the trajectory, so a run stopped by one resumes with a
+    larger one (the keys exist in [numerics] only)."""
+    return [ln for ln in toml_text.splitlines() if ln.split("=")[0].strip() not in _BUDGETS]
+
+
 def check_compatible(ckpt: Checkpoint, config, path="checkpoint") -> None:
     """Refuse to resume a checkpoint written by another version or for another config."""
     from flagwrap.io.config import config_to_toml
@@ -133,11 +143,11 @@ def check_compatible(ckpt: Checkpoint, config, path="checkpoint") -> None:
             f"{path} was written by flagwrap {ckpt.flagwrap_version}, this is {__version__}: "
             "a resumed run would not reproduce the original; rerun from the start or resume "
             f"with flagwrap {ckpt.flagwrap_version}")
-    if ckpt.config_toml != config_to_toml(config):
+    old, now = (_without_budgets(ckpt.config_toml), _without_budgets(config_to_toml(config)))
+    if old != now:
         import difflib
 
-        diff = [ln for ln in difflib.unified_diff(ckpt.config_toml.splitlines(),
-                                                  config_to_toml(config).splitlines(), lineterm="", n=0)
+        diff = [ln for ln in difflib.unified_diff(old, now, lineterm="", n=0)
                 if ln[:1] in "+-" and not ln.startswith(("+++", "---"))]
         raise UserInputError(f"{path} belongs to a different config (checkpoint vs now: "
                              f"{'; '.join(diff[:6])}); resume with the same config and options")
