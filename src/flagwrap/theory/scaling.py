@@ -8,7 +8,7 @@ the stability diagram:
 * ``zeta = pi eta / ln(0.18 P / a)``         (main text, resistive-force theory, Lighthill)
 * ``omega_c ~ A / (zeta R^3 L) ~ (E/eta)(a/R)^3 (a/L)``   (main text Eq. 2)
 * ``M_c = c (R/L)^-3`` with ``c = 0.06``     (main text, Fig. 5)
-* ``N_c ~= 0.5 A/R``, ``N_m ~= 0.9 A/R``      (main text, Fig. 3c and "Considering the maximal torque")
+* ``N_c ~= 0.5 A/R``, ``N_m ~= 0.9 A/R``      (main text, Fig. 4(c) and "Considering the maximal torque")
 
 The two forms of Eq. 2 differ by ``ln(0.18 P/a)/4`` (from ``A = pi E a^4/4`` and ``zeta``):
 ``A/(zeta R^3 L) = (E/eta)(a/R)^3(a/L) ln(0.18 P/a)/4``. A prefactor ``c_omega`` on the first
@@ -45,9 +45,9 @@ __all__ = [
 
 #: prefactor ``c`` of ``M_c = c (R/L)^-3`` fitted to the diagram (main text, Fig. 5)
 M_C_PREFACTOR = 0.06
-#: ``N_c R / A`` at the onset of buckling (main text, Fig. 3c)
+#: ``N_c R / A`` at the onset of buckling (main text, Fig. 4(c))
 N_C_COEFFICIENT = 0.5
-#: ``N_m R / A`` at the torque peak for ``omega/omega_c ~ 2`` (main text, Fig. 3c)
+#: ``N_m R / A`` at the torque peak for ``omega/omega_c ~ 2`` (main text, Fig. 4(c))
 N_PEAK_COEFFICIENT = 0.9
 
 
@@ -186,12 +186,12 @@ def machin_prefactor_from_omega(omega_prefactor: float, pitch: float, filament_r
 
 
 def critical_torque(bending: float, radius: float, coefficient: float = N_C_COEFFICIENT) -> float:
-    """Critical motor torque ``N_c = 0.5 A / R`` [N m] (main text, Fig. 3c)."""
+    """Critical motor torque ``N_c = 0.5 A / R`` [N m] (main text, Fig. 4(c))."""
     return _pos("coefficient", coefficient) * _pos("bending", bending) / _pos("radius", radius)
 
 
 def peak_torque(bending: float, radius: float, coefficient: float = N_PEAK_COEFFICIENT) -> float:
-    """Peak motor torque ``N_m = 0.9 A / R`` [N m] for ``omega/omega_c ~ 2`` (main text, Fig. 3c)."""
+    """Peak motor torque ``N_m = 0.9 A / R`` [N m] for ``omega/omega_c ~ 2`` (main text, Fig. 4(c))."""
     return critical_torque(bending, radius, coefficient)
 
 
