@@ -120,6 +120,7 @@ def test_failed_case_is_recorded_and_sweep_goes_on(tmp_path, fake):
     # re-run: nothing recomputed; --retry-failed recomputes only the failed one
     rep2 = run_sweep(spec, tmp_path / "s", scheduler="synchronous")
     assert (rep2.skipped, rep2.finished, rep2.failed) == (9, 0, 0)
+    assert len(rep2.failed_before) == 1 and "boom" in rep2.failed_before[0][1]  # still failed
     rep3 = run_sweep(spec, tmp_path / "s", scheduler="synchronous", retry_failed=True)
     assert (rep3.skipped, rep3.failed) == (8, 1)
 
@@ -261,3 +262,81 @@ def test_verdict_needs_completed_run_for_stable():
     st, err = verdict({"buckled": False, "state": "stable", "run_status": "failed", "message": "dt_min"})
     assert st == "failed" and "dt_min" in err
     assert verdict({"buckled": None, "state": "failed"})[0] == "failed"
+
+
+def _sweep_cli(tmp_path, fake, body, name="c"):
+    from flagwrap.cli.main import main
+
+    spec = tmp_path / f"{name}.toml"
+    spec.write_text(f'name = "{name}"\nrunner = "{fake}"\n' + textwrap.dedent(body))
+    return main(["sweep", str(spec), "--scheduler", "synchronous", "--out", str(tmp_path / "out"),
+                 "--no-progress"])
+
+
+def test_rerun_with_failed_cases_still_exits_1(tmp_path, fake, capsys):
+    body = """
+        [base]
+        filament = { n_beads = 21 }
+        [[cases]]
+        psi_deg = 70.0
+        turns = 2.0
+        machin = 2e5
+    """
+    assert _sweep_cli(tmp_path, fake, body) == 1
+    assert _sweep_cli(tmp_path, fake, body) == 1  # nothing rerun, the case is still failed
+    assert "failed in an earlier run" in capsys.readouterr().out
+
+
+def test_table_holds_the_current_spec_only(tmp_path, fake):
+    """Rows of an earlier version of the spec (other tolerance) stay on disk, reusable, but
+    the table and the diagram's rows are the current spec's."""
+    from flagwrap.sweep.store import SweepStore
+
+    def body(tol):
+        return f"""
+        [base]
+        filament = {{ n_beads = 21 }}
+        numerics = {{ tol = {tol} }}
+        [grid]
+        psi_deg = [70.0]
+        turns = [2.0]
+        machin = [100.0, 500.0]
+        """
+    assert _sweep_cli(tmp_path, fake, body(1e-4)) == 0
+    assert _sweep_cli(tmp_path, fake, body(1e-3)) == 0
+    store = SweepStore(tmp_path / "out" / "c")
+    assert len(list(store.iter_rows(everything=True))) == 4
+    assert len(store.table()) == 2 and len(list(store.iter_rows())) == 2
+    assert _sweep_cli(tmp_path, fake, body(1e-4)) == 0  # back: reused, not rerun
+    assert len(store.table()) == 2
+
+
+def test_boundary_test_runs_rerun_when_the_stop_rule_changes(tmp_path, fake, monkeypatch):
+    """The search's run cache is keyed by the config *and* the case function and stop_after:
+    a changed [run] stop_after must run the test runs again (not reuse the old verdicts)."""
+    log = tmp_path / "calls"
+    monkeypatch.setenv("FAKE_SWEEP_LOG", str(log))
+
+    def body(stop_after):
+        return f"""
+        mode = "boundary"
+        [base]
+        filament = {{ n_beads = 21 }}
+        [run]
+        stop_after = {stop_after}
+        [grid]
+        psi_deg = [70.0]
+        turns = [2.0]
+        [boundary]
+        rtol = 0.3
+        guess_ratio = 1.0
+        """
+    assert _sweep_cli(tmp_path, fake, body("2.0"), name="b") == 0
+    n1 = len(log.read_text().splitlines())
+    assert _sweep_cli(tmp_path, fake, body("false"), name="b") == 0
+    assert len(log.read_text().splitlines()) == 2 * n1  # every test run again
+    from flagwrap.sweep.store import SweepStore
+
+    store = SweepStore(tmp_path / "out" / "b")
+    assert len(store.boundaries()) == 1  # the current geometry result only
+    assert len(list(store.iter_rows())) == n1

@@ -111,12 +111,15 @@ def probe_config(cfg, machin: float, ccw_turns: float = 5.0, cw_turns: float = 1
     return cfg.replace(motor=motor, name=f"{cfg.name}_M{machin:.4g}")
 
 
-def config_key(cfg) -> str:
-    """16 hex digits of SHA-256 over the config's TOML text and the flagwrap version."""
+def config_key(cfg, extra: str = "") -> str:
+    """16 hex digits of SHA-256 over the config's TOML text and the flagwrap version, and
+    ``extra`` (whatever else decides the run's result, e.g. a sweep's runner and stop rule)."""
     from flagwrap import __version__
     from flagwrap.io.config import config_to_toml
 
     text = config_to_toml(cfg.replace(name="run"), for_hash=True) + f"\n# flagwrap {__version__}\n"
+    if extra:
+        text += f"# {extra}\n"
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -218,15 +221,19 @@ class RunCache:
     runner : callable, optional
         ``runner(cfg, path) -> dict`` with at least ``buckled``, ``waiting_time_turns``,
         ``state``, ``run_status``; default :func:`simulate_and_analyse`. Tests pass a fake.
+    key_extra : str
+        what besides the config decides ``runner``'s result (a sweep's case function and
+        ``stop_after``), hashed into the keys so a change of it runs again.
     """
 
-    def __init__(self, directory="out/critical", runner=None):
+    def __init__(self, directory="out/critical", runner=None, key_extra: str = ""):
         self.directory = Path(directory)
         self.runner = runner if runner is not None else simulate_and_analyse
+        self.key_extra = key_extra
         self.n_simulated = 0
 
     def paths(self, cfg):
-        key = config_key(cfg)
+        key = config_key(cfg, self.key_extra)
         return key, self.directory / f"{key}.nc", self.directory / f"{key}.json"
 
     def run(self, cfg) -> CriticalRun:

@@ -70,10 +70,14 @@ def run(args) -> int:
           f"wall time {rep.wall_time_s:.1f} s")
     for key, err in rep.errors:
         print(f"  FAILED {key}: {err}")
+    if rep.failed_before:
+        print(f"  {len(rep.failed_before)} failed in an earlier run, kept (--retry-failed reruns them):")
+        for key, err in rep.failed_before:
+            print(f"  FAILED {key}: {err}")
     if spec.mode == "boundary":
         for b in store.boundaries():
             print(f"  psi={b['psi_deg']:5.1f} n={b['turns']:4.2f} R/L={b['r_over_l']:.4f} "
                   f"M_c={fmt_float(b.get('machin_c'), '.1f')} bracket={b.get('bracket')} "
                   f"converged={b.get('converged')} status={b['status']}")
     print(f"table: {rep.table_path}")
-    return 0 if rep.failed == 0 else 1
+    return 0 if rep.failed == 0 and not rep.failed_before else 1

@@ -69,7 +69,9 @@ def run_geometry(case: Case, root, boundary: dict) -> dict:
         search = CriticalSearch(rtol=boundary["rtol"], cw_turns=case.run["cw_turns"],
                                 ccw_turns=case.run["ccw_turns"], factor=boundary["factor"],
                                 max_runs=boundary["max_runs"],
-                                cache=RunCache(store.critical, runner=runner))
+                                cache=RunCache(store.critical, runner=runner, key_extra=json.dumps(
+                                    {"runner": case.runner, "stop_after": case.run.get("stop_after")},
+                                    sort_keys=True)))
         search.compute(case.config(), guess=boundary["guess_ratio"] * case.machin_scaling)
         s = search.summary()
         out.update(status="ok", error=None, machin_c=s["machin_c"], bracket=s["bracket"],

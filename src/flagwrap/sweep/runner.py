@@ -109,6 +109,7 @@ class SweepReport:
     wall_time_s: float = 0.0
     table_path: Path | None = None
     errors: list = field(default_factory=list)
+    failed_before: list = field(default_factory=list)  # (key, error) kept from earlier runs
 
 
 def _ok(row: dict | None) -> bool:
@@ -165,6 +166,8 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
         fn, args = run_geometry, (spec.boundary,)
     todo = [c for c, d in zip(items, done) if d is None or (retry_failed and not _ok(d))]
     report = SweepReport(root=Path(root), total=len(items), skipped=len(items) - len(todo))
+    report.failed_before = [(k, d.get("error")) for k, d in zip(keys, done)
+                            if d is not None and not _ok(d) and not retry_failed]
 
     bar = None
     if progress:
@@ -213,6 +216,14 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
     if bar is not None:
         bar.close()
     report.wall_time_s = time.perf_counter() - t0
+    row_keys = keys
+    if spec.mode == "boundary":  # the rows are the searches' test runs
+        row_keys = []
+        for c, k in zip(items, keys):
+            p = store.boundary / f"{k}.json"
+            res = json.loads(p.read_text()) if p.is_file() else {}
+            row_keys += [c.with_machin(r["machin"]).key for r in res.get("runs") or ()]
+    store.write_manifest(row_keys, keys if spec.mode == "boundary" else ())
     report.table_path = store.export()
     return report
 

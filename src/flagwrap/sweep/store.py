@@ -6,13 +6,17 @@ Layout of ``out/sweeps/<name>/``::
     rows/<key>.json        the case's row: parameters, status, class, t_c, error (atomic rename)
     boundary/<gkey>.json   boundary mode: M_c bracket of one geometry (atomic rename)
     critical/              boundary mode: the analysis.critical run cache of the searches
+    current.json           the row keys and geometry keys of the spec last run here: the
+                           table, the boundaries and the diagram show those only
     table.parquet          the table of all rows, rewritten at the end of each sweep
                            (without pyarrow: table.nc, netCDF4, and table.csv)
 
 A row is written with ``tempfile`` + ``fsync`` + ``os.replace`` into ``rows/``: after a
 SIGKILL at any instant a row exists complete or not at all, and one file per key makes a
-duplicated row impossible. Nothing is appended in place. The table is built by reading every
-row (:meth:`SweepStore.table`); the exported file is only a convenience copy.
+duplicated row impossible. Nothing is appended in place. The table is built by reading the
+rows (:meth:`SweepStore.table`); the exported file is only a convenience copy. Rows of an
+earlier version of the spec (another tolerance, say) stay on disk, reused if the spec comes
+back, but are not mixed into the table: ``current.json`` names the current ones.
 """
 
 from __future__ import annotations
@@ -91,17 +95,36 @@ class SweepStore:
         return sum(len(remove_stale_temporaries(folder=d))
                    for d in (self.runs, self.rows, self.boundary, self.critical) if d.is_dir())
 
-    def iter_rows(self):
-        """Every complete row (sorted by key)."""
+    @property
+    def manifest_path(self) -> Path:
+        return self.root / "current.json"
+
+    def write_manifest(self, row_keys, gkeys=()) -> Path:
+        """Record the keys of the spec just run (see the module docstring)."""
+        return write_json_atomic({"rows": sorted(set(row_keys)), "boundaries": sorted(set(gkeys))},
+                                 self.manifest_path)
+
+    def _current(self, kind: str) -> set | None:
+        p = self.manifest_path
+        return set(json.loads(p.read_text())[kind]) if p.is_file() else None
+
+    def iter_rows(self, everything: bool = False):
+        """The current spec's complete rows, sorted by key (all rows on disk if
+        ``everything`` or if no spec has finished here yet)."""
         if not self.rows.is_dir():
             return
+        keep = None if everything else self._current("rows")
         for p in sorted(self.rows.glob("*.json")):
-            yield json.loads(p.read_text())
+            if keep is None or p.stem in keep:
+                yield json.loads(p.read_text())
 
     def boundaries(self) -> list[dict]:
+        """The current spec's boundary results (see :meth:`iter_rows`)."""
         if not self.boundary.is_dir():
             return []
-        return [json.loads(p.read_text()) for p in sorted(self.boundary.glob("*.json"))]
+        keep = self._current("boundaries")
+        return [json.loads(p.read_text()) for p in sorted(self.boundary.glob("*.json"))
+                if keep is None or p.stem in keep]
 
     def table(self, volatile: bool = True):
         """All rows as a ``pandas.DataFrame`` sorted by key (``volatile=False`` drops the
