@@ -326,8 +326,9 @@ def stretch_helix(helix: StretchedHelix, n_beads: int = 151, z_over_L_max: float
             raise UserInputError(f"z_over_L must increase within ({z0:.4f}, 1)")
         zs = np.concatenate([[z0], zl])
     b0 = 1.0 / (N - 1)
-    # core units: length L, energy A2/L -> force A2/L^2; ks = (pi E a b / b0) L^3/A2 with b0 in units of L
-    ks = 1.0 / (helix.stretch_compliance * helix.A2) / b0
+    # core units: length L, force A2/L^2, so a stiffness is in A2/L^3: the real bond spring
+    # pi E a b / (b0 L) [N/m] (b0 in units of L) is pi E a b L^2 / (A2 b0) in core units
+    ks = L ** 2 / (helix.stretch_compliance * helix.A2) / b0
     fun = _Energy(x0, 1.0, helix.C / helix.A2, ks)
     free = _free_mask(N)
     fscale_core = (helix.kappa0 * L) ** 2
