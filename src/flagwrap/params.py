@@ -223,18 +223,23 @@ class CellBody:
     """
 
     radius: float | None = None
-    radius_ratio: float | None = 0.6
+    radius_ratio: float | None = None  # 0.6 when radius is not given either
     cylinder_length: float | None = None
     enabled: bool = True
 
+    DEFAULT_RADIUS_RATIO = 0.6
+
     def __post_init__(self):
         if self.radius is not None:
+            if self.radius_ratio is not None:
+                raise UserInputError(
+                    f"body: give radius ({self.radius!r} m) or radius_ratio ({self.radius_ratio!r}), "
+                    "not both")
             _positive("body.radius", self.radius, "m")
-            _set(self, "radius_ratio", None)
         elif self.radius_ratio is not None:
             _positive("body.radius_ratio", self.radius_ratio)
         else:
-            raise UserInputError("body: give radius or radius_ratio")
+            _set(self, "radius_ratio", self.DEFAULT_RADIUS_RATIO)
         if self.cylinder_length is not None:
             _positive("body.cylinder_length", self.cylinder_length, "m")
         if not isinstance(self.enabled, bool):

@@ -71,6 +71,10 @@ def test_other_sections_reject():
         Numerics(tol=1.0)
     with pytest.raises(UserInputError, match="body.radius"):
         CellBody(radius=-2)
+    # "give either": both is an error (radius_ratio used to be dropped silently), neither 0.6
+    with pytest.raises(UserInputError, match="not both"):
+        CellBody(radius=0.05, radius_ratio=0.3)
+    assert CellBody().radius_ratio == 0.6 and CellBody(radius=0.05).radius_ratio is None
 
 
 def test_nonlocal_distance_of_a_tight_helix_is_the_pitch():
