@@ -33,8 +33,6 @@ from flagwrap.errors import UserInputError
 
 #: fraction of the available memory a single run may plan to use
 MEMORY_FRACTION = 0.5
-#: ``ny`` above which the linear solver is matrix-free (integrators/linear.py AUTO_CROSSOVER_NY)
-DENSE_CROSSOVER_NY = 4000
 _SUFFIX = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
 
 
@@ -60,6 +58,13 @@ def total_turns(config) -> float:
                      for p in config.motor.protocol))
 
 
+def _dense_solver(linear_solver: str, ny: int) -> bool:
+    """Whether the stage solver assembles a dense ``W`` (``make_w``'s choice with HI on)."""
+    from flagwrap.integrators.linear import AUTO_CROSSOVER_NY
+
+    return linear_solver == "dense" or (linear_solver == "auto" and ny <= AUTO_CROSSOVER_NY)
+
+
 def estimate(config) -> Estimate:
     fil, num = config.filament, config.numerics
     N = int(fil.n_beads)
@@ -67,7 +72,7 @@ def estimate(config) -> Estimate:
     n_saves = turns / num.save_every + 2.0
     frame = 8 * (3 * N + 3 * (N - 1) + (N - 1) + 8)
     ny = 4 * N  # 3 (N - 2) + (N - 2) + 1 free coordinates, rounded up
-    dense = num.hydrodynamics and ny <= DENSE_CROSSOVER_NY
+    dense = num.hydrodynamics and _dense_solver(num.linear_solver, ny)
     linalg = 5.0 * 8.0 * ny * ny if dense else 200.0 * 8.0 * ny
     return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame)
 
@@ -127,8 +132,8 @@ def check_memory(config, limit: float | None = None) -> Estimate:
                  "motor.protocol turns, increase numerics.save_every or reduce filament.n_beads")
     else:
         cause = (f"dense linear algebra for filament.n_beads={N} ({4 * N} unknowns) needs "
-                 f"{_gb(est.linalg_memory)}; reduce filament.n_beads or switch "
-                 "numerics.hydrodynamics off")
+                 f"{_gb(est.linalg_memory)}; reduce filament.n_beads, use numerics.linear_solver = "
+                 "\"auto\" or \"krylov\" (matrix-free), or switch numerics.hydrodynamics off")
     raise UserInputError(f"run would need about {_gb(est.memory)} of memory, more than the limit "
                          f"{_gb(limit)} ({why}): {cause}")
 

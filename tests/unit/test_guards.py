@@ -175,8 +175,14 @@ def test_resource_guards_name_the_inputs(tmp_path):
         "machin": 100, "protocol": [{"direction": "cw", "turns": 1e12}]}})
     with pytest.raises(UserInputError, match="motor.protocol turns.*numerics.save_every"):
         check_memory(long)
+    # the dense W (640 MB at 1000 beads) only where the stage solver forms it: "dense", or
+    # "auto" up to AUTO_CROSSOVER_NY unknowns; "auto" at 1000 beads is GCR (~6 MB)
     with pytest.raises(UserInputError, match=r"filament.n_beads=1000 \(4000 unknowns\)"):
-        check_memory(_cfg(tiny_toml(n_beads=1000)), limit=100e6)
+        check_memory(_cfg(tiny_toml(n_beads=1000), linear_solver="dense"), limit=100e6)
+    check_memory(_cfg(tiny_toml(n_beads=1000)), limit=100e6)
+    with pytest.raises(UserInputError, match=r"filament.n_beads=90 \(360 unknowns\)"):
+        check_memory(_cfg(tiny_toml(n_beads=90)), limit=3e6)  # auto: dense, 5.2 MB
+    check_memory(_cfg(tiny_toml(n_beads=90), linear_solver="krylov"), limit=3e6)
     with pytest.raises(UserInputError, match="disk"):
         check_disk(cfg, tmp_path / "o.nc", free=1000.0)
     huge = tmp_path / "huge.toml"
