@@ -58,3 +58,13 @@ def test_sweep_store_clean_spares_live_writers(tmp_path):
         f.write_text("partial")
     assert store.clean() == 2
     assert not dead.exists() and not legacy.exists() and live.exists() and remote.exists()
+
+
+def test_atomic_files_get_the_mode_of_a_plain_open(tmp_path):
+    # mkstemp's 0600 must not leak into results that other users or workers read
+    import stat
+
+    plain = tmp_path / "plain.txt"
+    plain.write_text("x")
+    out = atomic_write(tmp_path / "atomic.txt", lambda tmp: tmp.write_text("x"))
+    assert stat.S_IMODE(os.stat(out).st_mode) == stat.S_IMODE(os.stat(plain).st_mode)

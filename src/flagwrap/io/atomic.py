@@ -76,6 +76,16 @@ def fsync_dir(path) -> None:
         os.close(fd)
 
 
+def _read_umask() -> int:
+    # read once at import (setting it back and forth is not thread-safe later on)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _read_umask()
+
+
 def atomic_write(path, write, sync_dir: bool = False) -> Path:
     """Create ``path`` atomically; ``write(tmp)`` must write the whole file at ``tmp`` (a Path).
 
@@ -90,6 +100,8 @@ def atomic_write(path, write, sync_dir: bool = False) -> Path:
     os.close(fd)
     try:
         write(Path(tmp))
+        # mkstemp makes the file 0600; the result gets the mode a plain open() would give
+        os.chmod(tmp, 0o666 & ~_UMASK)
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
         os.replace(tmp, path)
