@@ -117,6 +117,16 @@ def test_vtp_points_and_fields_read_back_as_xml(tiny_run, exported):
     assert np.mean(a0["handedness"] == -1) > 0.9
 
 
+def test_without_forces_only_the_force_field_is_left_out(tiny_run, exported, tmp_path):
+    from flagwrap.io.vtk import export_vtk
+
+    export_vtk(read_run(tiny_run), tmp_path / "nf", with_forces=False)
+    _, with_f = _read_vtp_xml(sorted(exported.glob("filament_*.vtp"))[-1])
+    _, without = _read_vtp_xml(sorted((tmp_path / "nf").glob("filament_*.vtp"))[-1])
+    assert set(with_f) - set(without) == {"elastic_force"}
+    np.testing.assert_array_equal(with_f["excess_twist_rate"], without["excess_twist_rate"])
+
+
 def test_vtp_and_pvd_read_back_with_pyvista(tiny_run, exported):
     pv = pytest.importorskip("pyvista")
     ds = read_run(tiny_run)

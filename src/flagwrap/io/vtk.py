@@ -285,8 +285,9 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
     turns = ds["turns"].values
     secs = ds["time"].values
     tvals = turns if time_unit == "turns" else secs
-    forces = ElasticForces(config_of(ds)) if with_forces else None
-    rest = forces.rest_twist() if forces is not None else None
+    elastic = ElasticForces(config_of(ds))  # the rest twist is needed either way
+    rest = elastic.rest_twist()
+    forces = elastic if with_forces else None
     entries = []
     idx = range(0, len(turns), stride)
     width = max(4, len(str(len(turns) - 1)))
