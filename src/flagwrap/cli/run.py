@@ -24,7 +24,10 @@ import sys
 
 def add_arguments(p):
     p.add_argument("config", nargs="?", help="TOML config file (see examples/)")
-    p.add_argument("--case", help="built-in paper case instead of a file (see `flagwrap cases`)")
+    from flagwrap.cases import CASES
+
+    p.add_argument("--case", choices=sorted(CASES),
+                   help="built-in paper case instead of a file: " + ", ".join(sorted(CASES)))
     p.add_argument("-o", "--output", help="run file to write (.nc); default out/<name>.nc")
     p.add_argument("--figure", help="also write a summary figure (PNG/PDF) of tip height and torque")
     p.add_argument("--no-hi", action="store_true", help="switch long-range hydrodynamics off")
