@@ -340,3 +340,40 @@ def test_boundary_test_runs_rerun_when_the_stop_rule_changes(tmp_path, fake, mon
     store = SweepStore(tmp_path / "out" / "b")
     assert len(store.boundaries()) == 1  # the current geometry result only
     assert len(list(store.iter_rows())) == n1
+
+
+@pytest.mark.parametrize("change,needle", [
+    ({"run": {"stop_after": "x"}}, "run.stop_after must be"),
+    ({"run": {"stop_after": -3}}, "run.stop_after must be"),
+    ({"run": {"stop_after": True}}, "run.stop_after must be"),
+    ({"run": [1]}, r"\[run\] must be a table"),
+    ({"base": {"filament": 31}}, r"\[base\] filament must be a table"),
+    ({"base": {"motor": {"machn": 5}}}, r"\[base\] motor is set by each case"),
+    ({"base": {"numerics": {"hydrodynamics": False}}}, "numerics.hydrodynamics is set by each case; use hi"),
+    ({"base": {"filament": {"pitch": 0.1}}}, "filament.pitch is set by each case"),
+    ({"base": {"body": {"radius": 0.05}}}, "body.radius is set by each case; use r_over_rcell"),
+    ({"mode": "boundary", "boundary": {"max_runs": 0}}, "boundary.max_runs must be"),
+    ({"mode": "boundary", "boundary": {"rtol": "x"}}, "boundary.rtol must be"),
+    ({"mode": "boundary", "boundary": {"factor": 0.5}}, "boundary.factor must be"),
+    ({"mode": "boundary", "grid": {"psi_deg": [70.0], "turns": [2.0], "machin": [5.0]}},
+     "boundary mode searches M itself; remove machin"),
+])
+def test_bad_sweep_values_are_named_before_any_work(change, needle):
+    d = {"name": "t", "base": {"filament": {"n_beads": 21}},
+         "grid": {"psi_deg": [70.0], "turns": [2.0], "machin": [100.0]}}
+    d.update(change)
+    with pytest.raises(UserInputError, match=needle):
+        spec_from_dict(d)
+
+
+def test_sweep_cli_rejects_a_bad_scheduler_and_a_binary_file(tmp_path, capsys):
+    from flagwrap.cli.main import main
+
+    spec = tmp_path / "s.toml"
+    spec.write_text('[grid]\npsi_deg = [70.0]\nturns = [2.0]\nmachin = [100.0]\n')
+    assert main(["sweep", str(spec), "--scheduler", "sync", "--dry-run"]) == 2
+    assert "--scheduler must be" in capsys.readouterr().err
+    binary = tmp_path / "b.toml"
+    binary.write_bytes(b"\xff\xfe\x00bad")
+    assert main(["sweep", str(binary), "--dry-run"]) == 2
+    assert "not a UTF-8 text file" in capsys.readouterr().err

@@ -31,6 +31,7 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    import re
     from pathlib import Path
 
     from flagwrap.errors import UserInputError
@@ -39,6 +40,10 @@ def run(args) -> int:
     from flagwrap.sweep.store import SweepStore
 
     spec = load_spec(args.spec)
+    sched = args.scheduler
+    if sched not in ("local", "synchronous") and not re.fullmatch(r"[a-z]+://\S+|[^\s:/]+:\d+", sched):
+        raise UserInputError(f"--scheduler must be 'local', 'synchronous' or a Dask scheduler "
+                             f"address like tcp://HOST:PORT, got {sched!r}")
     if args.workers is not None and args.workers < 1:
         raise UserInputError(f"--workers must be >= 1, got {args.workers}")
     root = Path(args.out) / spec.name

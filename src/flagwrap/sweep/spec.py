@@ -277,6 +277,9 @@ def _make_case(p: dict, run: dict, base: dict, mode: str, where: str, runner=Non
     if not isinstance(hi, bool):
         raise UserInputError(f"{where}: hi must be true or false, got {hi!r}")
     speeds = [k for k in SPEED_KEYS if k in p]
+    if mode == "boundary" and speeds:
+        raise UserInputError(f"{where}: boundary mode searches M itself; remove {speeds[0]} "
+                             "(the first M tried is [boundary] guess_ratio x the scaling line)")
     if mode == "grid" and len(speeds) != 1:
         raise UserInputError(f"{where}: give exactly one of machin, omega_ratio_scaling per case")
     if speeds:
@@ -287,6 +290,48 @@ def _make_case(p: dict, run: dict, base: dict, mode: str, where: str, runner=Non
     else:
         machin = scaling_machin(rl)
     return Case(psi, n, rl, float(rr), machin, hi, dict(run), copy.deepcopy(base), runner)
+
+
+def _table(data: dict, key: str) -> dict:
+    v = data.get(key)
+    if v is None:
+        return {}
+    if not isinstance(v, dict):
+        raise UserInputError(f"sweep: [{key}] must be a table, got {type(v).__name__}")
+    return v
+
+
+def _number(v, where: str, allowed: str, ok) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not ok(v):
+        raise UserInputError(f"sweep: {where} must be {allowed}, got {v!r}")
+    return float(v)
+
+
+#: config values every case sets itself, with the sweep key that sets them
+CASE_SET = {("motor", None): "machin / omega_ratio_scaling and [run] ccw_turns / cw_turns",
+            ("name", None): "the sweep's name",
+            ("filament", "helix_radius"): "psi_deg / turns / r_over_l",
+            ("filament", "pitch"): "psi_deg / turns / r_over_l",
+            ("filament", "pitch_angle_deg"): "psi_deg / turns / r_over_l",
+            ("filament", "turns"): "psi_deg / turns / r_over_l",
+            ("body", "radius"): "r_over_rcell",
+            ("body", "radius_ratio"): "r_over_rcell",
+            ("numerics", "hydrodynamics"): "hi"}
+
+
+def _check_base(base: dict) -> None:
+    """[base] holds config sections; what a case sets itself may not be overridden there
+    (it would be ignored): the message names the sweep key to use."""
+    for section, table in base.items():
+        if (section, None) in CASE_SET:
+            raise UserInputError(f"sweep: [base] {section} is set by each case; use "
+                                 f"{CASE_SET[(section, None)]}")
+        if not isinstance(table, dict):
+            raise UserInputError(f"sweep: [base] {section} must be a table, got {type(table).__name__}")
+        for key in table:
+            if (section, key) in CASE_SET:
+                raise UserInputError(f"sweep: [base] {section}.{key} is set by each case; use "
+                                     f"{CASE_SET[(section, key)]}")
 
 
 def spec_from_dict(data: dict, name: str = "sweep") -> SweepSpec:
@@ -302,26 +347,30 @@ def spec_from_dict(data: dict, name: str = "sweep") -> SweepSpec:
     if mode not in ("grid", "boundary"):
         raise UserInputError(f"sweep: mode must be 'grid' or 'boundary', got {mode!r}")
     run = dict(RUN_DEFAULTS)
-    for k, v in (data.get("run") or {}).items():
+    for k, v in _table(data, "run").items():
         if k not in RUN_DEFAULTS:
             raise UserInputError(f"sweep: unknown key run.{k}; allowed: {', '.join(RUN_DEFAULTS)}")
         run[k] = v
     if run["stop_after"] is False:
         run["stop_after"] = None
     for k in ("ccw_turns", "cw_turns"):
-        if isinstance(run[k], bool) or not isinstance(run[k], (int, float)) or not run[k] > 0:
-            raise UserInputError(f"sweep: run.{k} must be a number > 0, got {run[k]!r}")
-        run[k] = float(run[k])
+        run[k] = _number(run[k], f"run.{k}", "a finite number > 0", lambda v: v > 0)
     if run["stop_after"] is not None:
-        run["stop_after"] = float(run["stop_after"])
-    base = data.get("base") or {}
-    if not isinstance(base, dict):
-        raise UserInputError("sweep: [base] must be a table of config sections")
+        run["stop_after"] = _number(run["stop_after"], "run.stop_after",
+                                    "a finite number of turns > 0, or false", lambda v: v > 0)
+    base = _table(data, "base")
+    _check_base(base)
     boundary = dict(BOUNDARY_DEFAULTS)
-    for k, v in (data.get("boundary") or {}).items():
+    for k, v in _table(data, "boundary").items():
         if k not in BOUNDARY_DEFAULTS:
             raise UserInputError(f"sweep: unknown key boundary.{k}; allowed: {', '.join(BOUNDARY_DEFAULTS)}")
         boundary[k] = v
+    for k, allowed, ok in (("rtol", "in (0, 1)", lambda v: 0 < v < 1),
+                           ("guess_ratio", "> 0", lambda v: v > 0),
+                           ("factor", "> 1", lambda v: v > 1),
+                           ("max_runs", "an integer >= 2", lambda v: v >= 2 and v == int(v))):
+        boundary[k] = _number(boundary[k], f"boundary.{k}", allowed, ok)
+    boundary["max_runs"] = int(boundary["max_runs"])
     params = []
     if "grid" in data:
         params += _expand(data["grid"], "sweep grid")
@@ -355,7 +404,9 @@ def load_spec(path) -> SweepSpec:
     if not path.is_file():
         raise UserInputError(f"sweep file not found: {path}")
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise UserInputError(f"malformed TOML in {path}: {exc}") from None
+    except UnicodeDecodeError:
+        raise UserInputError(f"{path} is not a UTF-8 text file") from None
     return spec_from_dict(data, name=path.stem)
