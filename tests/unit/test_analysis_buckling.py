@@ -124,3 +124,30 @@ def test_full_analysis_end_to_end():
     stable = BucklingAnalysis().compute(T, np.repeat(hanging()[None], T.size, 0), OMEGA, L, RC, H)
     assert stable.summary()["state"] == "stable"
     assert np.isnan(stable.summary()["waiting_time_turns"])
+
+
+def test_baseline_is_the_relaxed_ccw_state_even_with_a_stop_phase_before_cw():
+    # CCW to 10 T (the free end relaxes from -0.55 to -0.35 L), stop to 12 T, then CW with
+    # no change: not buckled. A baseline window ending at the switch saw only the stop phase
+    # and fell back to the first frame (-0.55), calling the run buckled at t = 0.
+    t = np.arange(0, 20 + 1e-9, 0.05)
+    om = np.where(t <= 10, 1.0, np.where(t <= 12, 0.0, -1.0))
+    h = -0.35 - 0.2 * np.exp(-t / 0.5)
+    w = WaitingTime().compute(t, h, om)
+    assert w.baseline == pytest.approx(-0.35, abs=1e-6)
+    assert not w.buckled
+
+
+def test_cw_torque_peak_is_the_most_negative_cw_value():
+    # a CCW torque larger in magnitude than the CW one: the peak must still be the CW value
+    t = np.arange(0, 20 + 1e-9, 0.05)
+    om = np.where(t <= 10, 1.0, -1.0)
+    N = 21
+    x = np.zeros((t.size, N, 3))
+    x[:, :, 2] = -np.linspace(0, 0.35, N)[None, :]
+    x[:, 1:, 0] = 0.03
+    tq = np.where(t <= 10, 0.9, -0.5)
+    tq[t > 15] = -0.3
+    s = BucklingAnalysis().compute(t, x, om, 1.0, 0.05, 0.1, tq).summary()
+    assert s["torque_peak_reduced"] == -0.5
+    assert 0 < s["torque_peak_turns"] <= 0.05 + 1e-9

@@ -74,7 +74,6 @@ from flagwrap.observables import (
     near_body_mask,
     perversion_index,
     plateau_value,
-    torque_peak,
     winding_turns,
 )
 
@@ -227,7 +226,13 @@ class WaitingTime(_Compute):
         i_s = find_switch(t, om)
         t_s = t[i_s - 1] if i_s > 0 else t[0]
         hs = _running_mean(h, round(self.smooth_turns / dt))
-        pre = (t <= t_s) & (t > t_s - self.baseline_turns) & (om > 0)
+        # baseline: the last baseline_turns of CCW driving before the switch (a "stop" phase
+        # may lie between; a window ending at t_s would then miss the relaxed CCW state)
+        ccw = np.flatnonzero((om > 0) & (t <= t_s))
+        pre = np.zeros_like(t, dtype=bool)
+        if ccw.size:
+            t_ccw = t[ccw[-1]]
+            pre = (om > 0) & (t <= t_ccw) & (t > t_ccw - self.baseline_turns)
         base = float(np.median(h[pre])) if pre.any() else float(h[0])
         above = hs - base >= self.threshold
         m = max(1, int(round(self.hold_turns / dt)))
@@ -501,8 +506,15 @@ class BucklingAnalysis(_Compute):
         self.perversion_turns = float(t[i[0]] - self.waiting.switch_turns) if i.size else float("nan")
         if torque_reduced is not None:
             _, tq = _series(t, torque_reduced)
-            self.torque_peak, pt = torque_peak(t, tq, start=self.waiting.switch_turns)
-            self.torque_peak_turns = pt - self.waiting.switch_turns
+            # the CW peak: the most negative torque strictly after the switch (the sample at
+            # t_s itself is still CCW), as paper_runs.torque_summary and Fig. 4(c) read it
+            cw = np.flatnonzero(t > self.waiting.switch_turns)
+            if cw.size:
+                j = int(cw[np.argmin(tq[cw])])
+                self.torque_peak = float(tq[j])
+                self.torque_peak_turns = float(t[j] - self.waiting.switch_turns)
+            else:
+                self.torque_peak = self.torque_peak_turns = float("nan")
             self.torque_final = plateau_value(t, tq, self.final.final_turns)
         else:
             self.torque_peak = self.torque_peak_turns = self.torque_final = float("nan")
