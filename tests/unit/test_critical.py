@@ -88,6 +88,26 @@ def test_bracket_given_and_wrong_belief_widened(tmp_path, cfg):
     assert s.converged and s.bracket[0] < 150.0 <= s.bracket[1]
 
 
+class WindowRunner(FakeRunner):
+    """Buckled only for 100 < M < 300 (non-monotone, like the records without HI)."""
+
+    def __call__(self, cfg, path):
+        res = super().__call__(cfg, path)
+        b = 100.0 < cfg.machin < 300.0
+        res.update(buckled=b, state="folding" if b else "stable")
+        return res
+
+
+def test_inverted_bracket_is_not_bisected(tmp_path, cfg):
+    # the given bracket's low end buckles, its high end does not: no switch lies between them,
+    # so the search must go below the buckled end (it bisected 200..400 and reported M_c ~ 204)
+    s = CriticalSearch(rtol=0.05, cache=RunCache(tmp_path, runner=WindowRunner())).compute(
+        cfg, bracket=(200.0, 400.0))
+    lo, hi = s.bracket
+    assert s.converged and lo <= 100.0 < hi <= 105.0
+    assert not s.summary()["monotone"]
+
+
 def test_max_runs_not_converged(tmp_path, cfg):
     s = CriticalSearch(rtol=1e-4, max_runs=4, cache=RunCache(tmp_path, runner=FakeRunner())).compute(cfg)
     assert not s.converged and len(s.runs) == 4

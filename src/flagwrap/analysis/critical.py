@@ -354,21 +354,27 @@ class CriticalSearch:
             else:
                 lo = m
         # bracketing
-        while (lo is None or hi is None) and len(self._runs) < self.max_runs:
-            if hi is None:
-                m = lo * self.factor
-                if self._test(m):
-                    hi = m
+        while True:
+            while (lo is None or hi is None) and len(self._runs) < self.max_runs:
+                if hi is None:
+                    m = lo * self.factor
+                    if self._test(m):
+                        hi = m
+                    else:
+                        lo = m
                 else:
-                    lo = m
-            else:
-                m = hi / self.factor
-                if self._test(m):
-                    hi = m
-                else:
-                    lo = m
-        if lo is not None and hi is not None and lo > hi:  # non-monotone bracket beliefs
-            lo, hi = min(lo, hi), max(lo, hi)
+                    m = hi / self.factor
+                    if self._test(m):
+                        hi = m
+                    else:
+                        lo = m
+            if lo is not None and hi is not None and lo > hi:
+                # a buckled M below a stable one (non-monotone): a bracket between them holds
+                # no switch, so look below the smallest buckled M for a stable one (the
+                # lowest switch; summary()["monotone"] reports the inversion)
+                lo = None
+                continue
+            break
         # bisection in log M
         while (lo is not None and hi is not None and hi / lo - 1 > self.rtol
                and len(self._runs) < self.max_runs):
