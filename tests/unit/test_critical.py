@@ -152,6 +152,15 @@ def test_cli_with_fake_runner(tmp_path, cfg, monkeypatch, capsys):
     assert rc == 0
     assert "M_c" in out and "omega_c" in out
     assert out.count("out/critical") == 0 and out.count(".nc") >= 3
+    # --json is strict JSON: the stable runs' NaN waiting times inside "runs" become null
+    import json
+
+    def no_nan(name):
+        raise ValueError(f"{name} in the JSON output")
+
+    rc = main(["critical", str(path), "--rtol", "0.1", "--cache", str(tmp_path / "cache"), "--json"])
+    res = json.loads(capsys.readouterr().out, parse_constant=no_nan)
+    assert rc == 0 and any(r["waiting_time"] is None for r in res["runs"])
 
 
 def test_chunked_run_equals_full_run(cfg):

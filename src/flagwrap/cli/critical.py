@@ -36,7 +36,6 @@ def _fmt(v, f):
 
 def run(args) -> int:
     import json
-    import math
 
     from flagwrap.analysis.critical import CriticalSearch, RunCache
     from flagwrap.io.config import load_config
@@ -64,8 +63,9 @@ def run(args) -> int:
     search.compute(cfg, guess=args.guess, bracket=args.bracket)
     s = search.summary()
     if args.json:
-        print(json.dumps({k: (None if isinstance(v, float) and math.isnan(v) else v)
-                          for k, v in s.items()}, sort_keys=True))
+        from flagwrap.sweep.store import jsonable  # NaN -> null at every depth (runs too)
+
+        print(json.dumps(jsonable(s), sort_keys=True, allow_nan=False))
         return 0 if s["converged"] else 1
     lo, hi = s["bracket"]
     print(f"runs: {len(s['runs'])} ({search.cache.n_simulated} simulated, "
