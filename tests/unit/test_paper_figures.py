@@ -87,3 +87,14 @@ def test_departure_time():
     # 1-turn centred mean reaches +0.05 L about half a window before the raw ramp does
     assert 0.5 < td < 1.3
     assert np.isnan(departure_time(fake_run()))
+
+
+def test_fig6_fits_count_only_the_times_a_power_law_can_use():
+    # t_c = 0 (buckled at the switch) is finite but dropped by PowerLawFit: counting it let
+    # figure fig6 / figS7 call a 3-point fit on 1 usable point and abort
+    from flagwrap.errors import UserInputError
+
+    tc = np.array([2.0, 0.0, 0.0, np.nan])
+    assert figures._n_fittable(tc) == 1
+    with pytest.raises(UserInputError):
+        PowerLawFit().compute(np.array([0.1, 0.5, 1.0, 2.0]), tc)

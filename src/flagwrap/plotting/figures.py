@@ -311,6 +311,13 @@ def _geometry_title(root, mc):
     return rf"$\psi$ = {fil.pitch_angle_deg:.0f}$^\circ$, n = {fil.turns:g}, this model's $M_c$ = {mc:.0f}"
 
 
+def _n_fittable(times) -> int:
+    """Times a power-law fit uses: finite and > 0 (PowerLawFit drops t_c = 0, which a run
+    buckled at the switch has)."""
+    t = np.asarray(times, dtype=float)
+    return int((np.isfinite(t) & (t > 0)).sum())
+
+
 def _fig6_data(root=".", on_run=None):
     """Critical search of :data:`flagwrap.analysis.paper_runs.FIG6_GEOMETRY`, the sweep, the fit."""
     from flagwrap.analysis import paper_runs
@@ -320,7 +327,7 @@ def _fig6_data(root=".", on_run=None):
     rows = paper_runs.fig6_runs(mc, on_run=on_run, root=root)
     eps = np.array([r["eps"] for r in rows])
     tc = np.array([r["waiting_time"] for r in rows])
-    fit = PowerLawFit().compute(eps, tc) if np.isfinite(tc).sum() >= 3 else None
+    fit = PowerLawFit().compute(eps, tc) if _n_fittable(tc) >= 3 else None
     return mc, rows, eps, tc, fit
 
 
@@ -380,14 +387,14 @@ def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
     paths = _save(fig, Path(outdir), "fig6")
     _mpl().close(fig)
     fits = {}
-    n_ok = int(np.isfinite(tc).sum())
+    n_ok = _n_fittable(tc)
     if fit is not None:
         fits["free_beta"] = fit.summary()
     if n_ok >= 2:
         fits["beta_1"] = PowerLawFit(fix_beta=1.0).compute(eps, tc).summary()
-    if np.isfinite(cross).sum() >= 3:
+    if _n_fittable(cross) >= 3:
         fits["crossing_free_beta"] = PowerLawFit().compute(eps, cross).summary()
-    if np.isfinite(depart).sum() >= 3:
+    if _n_fittable(depart) >= 3:
         fits["departure_free_beta"] = PowerLawFit().compute(eps, depart).summary()
     if n_ok >= 4:
         m = np.array([r["machin"] for r in rows])
