@@ -72,6 +72,12 @@ def test_view_limits_cover_all_frames_with_one_scale():
     (u0, u1), (z0, z1) = view_limits(frames, scene)
     assert u0 < -0.2 and u1 > 0.2 and np.isclose(u0, -u1)  # centred on the body axis
     assert z0 < -0.3 and z1 >= 0.1
+    # a filament that climbs above a short body's top is framed whole (it was cut at the top)
+    short = Scene(0.0015, 0.05, 0.05, 0.4)
+    frames[1, 2] = [0.0, 0.0, 0.3]
+    assert view_limits(frames, short)[1][1] > 0.3
+    frames[1, 2] = [0.0, 0.0, -0.3]  # hanging below: the body is shown one radius above the cap
+    assert 0.1 <= view_limits(frames, short)[1][1] < 0.15
 
 
 def test_snapshot_strip_headless(tiny_run, tmp_path):
@@ -100,3 +106,16 @@ def test_snapshot_time_outside_run_is_a_user_error(tiny_run, tmp_path):
     rc = main(["snapshots", str(tiny_run), "-o", str(tmp_path / "s.png"), "-t", "5"])
     assert rc == 2
     assert main(["snapshots", str(tmp_path / "missing.nc")]) == 2
+
+
+def test_summary_figure_marks_the_switch_at_its_time(tiny_run):
+    # the frame at the switch carries the old phase's speed: the line belongs at its time
+    # (find_switch's t_s), not one save interval later
+    from flagwrap.analysis.buckling import find_switch
+    from flagwrap.io.runfile import read_run
+    from flagwrap.plotting.summary import _switch_turns
+
+    ds = read_run(tiny_run)
+    t = ds["turns"].values
+    i = find_switch(t, ds["omega"].values)
+    assert _switch_turns(ds) == [pytest.approx(t[i - 1])]

@@ -383,8 +383,10 @@ def view_limits(frames: np.ndarray, scene: Scene, cameras=CAMERAS, margin: float
     zmin = float(frames[..., 2].min()) - a
     zmax = float(frames[..., 2].max()) + a
     if scene.has_body:
-        zmax = max(zmax, 2.0 * scene.body_radius)
-        zmax = min(zmax, scene.body_radius + scene.body_length) if zmax > 0 else zmax
+        # the body is shown up to where the filament climbs, at least one radius above the
+        # cap, never past its top; the filament itself is never cut
+        body_top = min(max(zmax, 2.0 * scene.body_radius), scene.body_radius + scene.body_length)
+        zmax = max(zmax, body_top)
     m = margin * scene.length
     return (-half - m, half + m), (zmin - m, zmax + m)
 

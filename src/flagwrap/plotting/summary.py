@@ -41,4 +41,5 @@ def _switch_turns(ds):
 
     om = np.sign(ds["omega"].values)
     idx = np.nonzero(np.diff(om) != 0)[0]
-    return [float(ds["turns"].values[i + 1]) for i in idx]
+    # the frame at a switch is recorded with the old phase's speed: its time is the switch
+    return [float(ds["turns"].values[i]) for i in idx]
