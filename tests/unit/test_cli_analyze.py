@@ -98,3 +98,12 @@ def test_ccw_only_run_is_reported(tiny_run, tmp_path, capsys):
     ds.to_netcdf(p, engine="h5netcdf")
     assert main(["analyze", str(p)]) == 2
     assert "never turns CW" in capsys.readouterr().err
+
+
+def test_run_files_with_the_old_integrator_name_still_load(tiny_run):
+    # run files written before the ROS2 stepper was renamed say integrator = "rosenbrock"
+    ds = read_run(tiny_run)
+    text = ds.attrs["config_toml"]
+    assert 'integrator = "ros34pw2"' in text
+    ds.attrs["config_toml"] = text.replace('integrator = "ros34pw2"', 'integrator = "rosenbrock"')
+    assert config_of(ds).numerics.integrator == "ros2"

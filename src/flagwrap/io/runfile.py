@@ -142,4 +142,8 @@ def config_of(ds):
     """The :class:`~flagwrap.params.Config` stored in a run dataset."""
     from flagwrap.io.config import config_from_dict, tomllib
 
-    return config_from_dict(tomllib.loads(ds.attrs["config_toml"]))
+    data = tomllib.loads(ds.attrs["config_toml"])
+    num = data.get("numerics", {})
+    if num.get("integrator") == "rosenbrock":  # ROS2's name in run files before 2026-11-25
+        num["integrator"] = "ros2"
+    return config_from_dict(data)
