@@ -71,3 +71,14 @@ def test_movie_of_missing_file_is_a_user_error(tmp_path):
     from flagwrap.cli.main import main
 
     assert main(["movie", str(tmp_path / "none.nc"), "--quiet"]) == 2
+
+
+def test_bad_movie_and_snapshot_outputs_are_one_line_errors(tiny_run, tmp_path, capsys):
+    from flagwrap.cli.main import main
+
+    assert main(["movie", str(tiny_run), "-o", str(tmp_path / "m.png")]) == 2
+    assert "must end in .mp4 or .gif" in capsys.readouterr().err
+    assert main(["snapshots", str(tiny_run), "-o", str(tmp_path / "s.png"), "--formats", "xyz"]) == 2
+    assert "--formats: xyz not supported" in capsys.readouterr().err
+    assert main(["snapshots", str(tiny_run), "-o", str(tmp_path / "s.png"), "--dpi", "0"]) == 2
+    assert "--dpi must be >= 1" in capsys.readouterr().err

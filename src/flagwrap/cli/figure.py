@@ -7,8 +7,9 @@ Figures (registry FIGURES, extended as figures are added):
         helix at omega/omega_c = 0.85, 2.05 (this model's omega_c; docs/critical.md)
   fig5  stability diagram (R/L)^3 vs M from the sweep table (flagwrap sweep
         examples/sweeps/fig5.toml or fig5-quick.toml), scaling line 0.06 and our fit, bacteria
-  fig6  waiting time t_c/T against eps with 0.5/eps, the fit and a log-log inset (n = 3)
-  figS7 free-end height for several omega with t_c marked (SI Fig. S7(a), n = 3)
+  fig6  waiting time t_c/T against eps with 0.5/eps, the fit and a log-log inset (the
+        Fig. 4(a) helix, n = 2: flagwrap.analysis.paper_runs.FIG6_GEOMETRY)
+  figS7 free-end height for several omega with t_c marked (SI Fig. S7(a), same helix)
 
 Example::
 

@@ -30,9 +30,18 @@ def run(args) -> int:
     ds = read_run(args.run_file)
     out = Path(args.output) if args.output else Path(args.run_file).with_name(
         Path(args.run_file).stem + "_snapshots.png")
-    formats = [f.strip() for f in args.formats.split(",") if f.strip()]
+    formats = [f.strip().lower() for f in args.formats.split(",") if f.strip()]
     if not formats:
         raise UserInputError("--formats is empty")
+    from matplotlib.figure import Figure
+
+    known = Figure().canvas.get_supported_filetypes()
+    bad = [f for f in formats if f not in known]
+    if bad:
+        raise UserInputError(f"--formats: {', '.join(bad)} not supported; choose from "
+                             f"{', '.join(sorted(known))}")
+    if args.dpi < 1:
+        raise UserInputError(f"--dpi must be >= 1, got {args.dpi}")
     paths = write_snapshots(ds, out, formats=formats, dpi=args.dpi, times=args.times, n=args.n)
     for p in paths:
         print(p)

@@ -242,8 +242,8 @@ def write_movie(ds, path, fps: float = 25.0, speed=None, size=DEFAULT_SIZE, prog
     Parameters
     ----------
     ds : run dataset
-    path : output file; ``.gif`` forces a GIF; any other name gets an MP4, or ``.gif`` in its
-        place when ffmpeg is unavailable
+    path : output file: ``.mp4`` (``.gif`` in its place when ffmpeg is unavailable) or
+        ``.gif``; a name without a suffix gets ``.mp4``; any other suffix is an error
     fps : frames per second [1/s]
     speed : replay speed: number, ``"100x"``, or ``None``/``"auto"`` (one frame per save)
     size : ``"WxH"`` or (W, H) [pixel], rounded to multiples of 16
@@ -251,9 +251,15 @@ def write_movie(ds, path, fps: float = 25.0, speed=None, size=DEFAULT_SIZE, prog
     """
     import imageio.v2 as iio
 
+    from flagwrap.errors import UserInputError
+
+    path = Path(path)
+    if path.suffix == "":
+        path = path.with_suffix(".mp4")
+    if path.suffix.lower() not in (".mp4", ".gif"):
+        raise UserInputError(f"movie file must end in .mp4 or .gif, got {str(path)!r}")
     frames = MovieFrames(ds, fps=fps, speed=parse_speed(speed), size=size,
                          renderer_kwargs=renderer_kwargs)
-    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     gif = path.suffix.lower() == ".gif" or not ffmpeg_available()
     if gif:
