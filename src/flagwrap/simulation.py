@@ -148,6 +148,25 @@ class Simulation:
         except (ValueError, FloatingPointError):
             return ""
 
+    def _start_contact_hint(self, info) -> str:
+        """Why a run that stops at once may have done so: free beads next to the clamp that
+        start inside the body's contact range (a fine chain: the repulsion throws them off)."""
+        s = self.system
+        cutoff = getattr(s.body, "cutoff", None)
+        if cutoff is None or s.N <= s.nc:
+            return ""
+        d = info.distance[s.nc:]
+        inside = np.flatnonzero(d < cutoff)
+        if not inside.size:
+            return ""
+        i = int(inside[np.argmin(d[inside])]) + s.nc
+        L = self.config.filament.length
+        return (f"; bead {i} starts {info.distance[i] * L * 1e3:.3g} mm from the cell body, inside "
+                f"its contact range a (1 + contact.range) = {cutoff * L * 1e3:.3g} mm: with "
+                f"filament.n_beads = {self.config.filament.n_beads} (bond {s.bond * L * 1e3:.3g} mm) "
+                "beads next to the clamp start in contact; use fewer beads or a smaller "
+                "contact.range")
+
     def _checkpoint_toml(self) -> str:
         if self._config_toml is None:
             from flagwrap.io.config import config_to_toml
@@ -207,6 +226,7 @@ class Simulation:
             self._record(traj, t, y, info, sched(t))
             next_save = t + self.save_dt
         base = info.frames
+        info_start, t_start = info, t
         n_steps0 = traj.n_steps  # the budgets count this invocation (plus budget_used)
         steps_left = self.max_steps - int(budget_used[0])
         wall_left = self.max_wall - float(budget_used[1])
@@ -296,6 +316,8 @@ class Simulation:
                 self._record(traj, t, y, info, sched(t - eps))
             traj.status = "failed"
             traj.message = str(stop)
+            if t < t_start + self.save_dt:  # stopped at once: say if it started in contact
+                traj.message += self._start_contact_hint(info_start)
         except (KeyboardInterrupt, SystemError) as exc:
             if isinstance(exc, SystemError) and not _caused_by_interrupt(exc):
                 raise

@@ -320,3 +320,18 @@ def test_interrupt_wrapped_by_numba_is_still_an_interrupt():
     other.integrator.step = lambda *a, **k: (_ for _ in ()).throw(SystemError("genuine"))
     with pytest.raises(SystemError, match="genuine"):  # a real SystemError is not swallowed
         other.run()
+
+
+def test_a_run_that_stops_at_once_says_when_beads_start_in_contact():
+    # 400 beads on the Fig. 4(a) helix: bond 1 mm, so the first free bead starts 1.35 mm from
+    # the body, inside the 3 mm contact range, and the repulsion throws it off at t = 0
+    with open("examples/fig4a.toml", "rb") as fh:
+        d = tomllib.load(fh)
+    d["filament"]["n_beads"] = 400
+    d["motor"]["protocol"] = [{"direction": "ccw", "turns": 0.01}]
+    traj = simulate(config_from_dict(d))
+    assert traj.status == "failed"
+    assert re.search(r"bead 2 starts 1.35 mm from the cell body, inside its contact range "
+                     r"a \(1 \+ contact.range\) = 3 mm: with filament.n_beads = 400", traj.message)
+    # a run that starts clear of the body never gets the hint
+    assert "contact range" not in simulate(_cfg(max_steps=5)).message
