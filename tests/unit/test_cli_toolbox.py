@@ -82,6 +82,9 @@ def test_viscosity(tmp_path, capsys):
     assert rc == 0 and "U = 8.559e-20" in out
     rc, out, _ = _run(["viscosity", "at", "--temperature", "20", "--celsius"], capsys)
     assert rc == 0 and "293.15 K" in out
+    # a forgotten --celsius (25 "K") printed eta = 3e98 Pa s; now a one-line error
+    rc, out, _ = _run(["viscosity", "at", "--temperature", "25", "--machin", "283"], capsys)
+    assert rc == 2 and "below 200 K" in out and "--celsius" in out  # (_run prints errors)
 
 
 def test_density(tmp_path, capsys):

@@ -4,8 +4,9 @@ Every case (geometry psi, n, R/L, R/R_cell; M or omega/omega_c of the scaling li
 test run of CCW then K CW turns, stopped 2 turns after buckling. Each finished case is written
 atomically as it finishes (runs/KEY.nc + rows/KEY.json, KEY = hash of the case's config and
 the flagwrap version); re-running the same sweep skips finished cases; a case that fails is
-recorded with its error and the sweep goes on. At the end the table of all rows is written to
-table.parquet (pyarrow installed) or table.csv. See docs/sweeps.md.
+recorded with its error and the sweep goes on. At the end the table of the spec's rows is
+written to table.parquet (pyarrow installed) or table.nc (netCDF4) and table.csv. Exit code 1
+if any case of the spec is failed. See docs/sweeps.md.
 
 Examples::
 

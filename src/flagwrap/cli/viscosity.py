@@ -68,13 +68,13 @@ def run(args: argparse.Namespace) -> int:
             print(f"rho_gly = {res.fluid_density:.6g} +- {res.fluid_density_error:.2g} kg/m^3")
     elif args.action == "andrade":
         c = read_csv_columns(args.csv, ("T", "eta"), ("eta_err",))
-        T = c["T"] + 273.15 if args.celsius else c["T"]
+        T = _kelvin(c["T"], args.celsius)
         res = vis.fit_andrade(T, c["eta"], c.get("eta_err"))
         print(f"eta_inf = {res.eta_inf:.6g} Pa s (ln: {res.log_eta_inf:.6g} +- {res.log_eta_inf_error:.2g})")
         print(f"U = {res.energy:.6g} +- {res.energy_error:.2g} J")
         print(f"corr(ln eta_inf, U) = {res.correlation:.4f}; reduced chi2 = {res.chi2_reduced:.3g}")
     else:
-        T = args.temperature + 273.15 if args.celsius else args.temperature
+        T = float(_kelvin(args.temperature, args.celsius))
         kw = {}
         if args.eta_inf is not None:
             kw["eta_inf"] = args.eta_inf
@@ -84,3 +84,17 @@ def run(args: argparse.Namespace) -> int:
         if args.machin is not None:
             print(f"M({T:.2f} K) = {vis.machin_at_temperature(args.machin, T, **kw):.6g} (from M(293.15 K) = {args.machin:g})")
     return 0
+
+
+def _kelvin(T, celsius: bool):
+    """Temperatures in K; values below 200 K are refused as a forgotten ``--celsius`` (the
+    Andrade law of the paper's glycerol holds in its liquid range, above ~290 K)."""
+    import numpy as np
+
+    from flagwrap.errors import UserInputError
+
+    T = np.asarray(T, dtype=float) + (273.15 if celsius else 0.0)
+    if np.any(T < 200.0):
+        raise UserInputError(f"temperature {float(np.min(T)):g} K is below 200 K: give Kelvin, "
+                             "or degrees Celsius with --celsius")
+    return T
