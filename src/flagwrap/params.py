@@ -217,7 +217,7 @@ class CellBody:
     """Rigid cell body: a cylinder of radius ``R_cell`` capped below by a hemisphere.
 
     Give either ``radius`` [m] or ``radius_ratio = R / R_cell`` (default 0.6, the paper's coil
-    helices: SI Fig. S7). ``cylinder_length`` [m] defaults to ``5 R_cell`` (the experiment's
+    helices: SI Fig. S7); both, with a ratio other than the default, is an error. ``cylinder_length`` [m] defaults to ``5 R_cell`` (the experiment's
     25 cm cylinder of 5 cm radius). The fluid passes through the body (paper, Methods); only a
     short-ranged repulsion keeps beads outside. ``enabled = false`` removes it altogether.
     """
@@ -231,11 +231,14 @@ class CellBody:
 
     def __post_init__(self):
         if self.radius is not None:
-            if self.radius_ratio is not None:
+            # the default ratio that __post_init__ filled in yields to a radius (so that
+            # dataclasses.replace(CellBody(), radius=...) works); any other ratio is a conflict
+            if self.radius_ratio is not None and self.radius_ratio != self.DEFAULT_RADIUS_RATIO:
                 raise UserInputError(
                     f"body: give radius ({self.radius!r} m) or radius_ratio ({self.radius_ratio!r}), "
                     "not both")
             _positive("body.radius", self.radius, "m")
+            _set(self, "radius_ratio", None)
         elif self.radius_ratio is not None:
             _positive("body.radius_ratio", self.radius_ratio)
         else:

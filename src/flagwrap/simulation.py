@@ -155,7 +155,9 @@ class Simulation:
         cutoff = getattr(s.body, "cutoff", None)
         if cutoff is None or s.N <= s.nc:
             return ""
-        d = info.distance[s.nc:]
+        # the beads next to the clamp: as far along the chain as the contact range reaches
+        near = s.nc + int(np.ceil(cutoff / s.bond)) + 1
+        d = info.distance[s.nc:near]
         inside = np.flatnonzero(d < cutoff)
         if not inside.size:
             return ""
@@ -227,6 +229,7 @@ class Simulation:
             next_save = t + self.save_dt
         base = info.frames
         info_start, t_start = info, t
+        fresh = resume is None and y0 is None  # the configured initial state
         n_steps0 = traj.n_steps  # the budgets count this invocation (plus budget_used)
         steps_left = self.max_steps - int(budget_used[0])
         wall_left = self.max_wall - float(budget_used[1])
@@ -306,7 +309,7 @@ class Simulation:
                             ck_on = False
                         last_ck = _time.perf_counter()
                 if over:
-                    raise _Stop(f"t/T={t / TWO_PI:.6g}: {over}")
+                    raise _Stop(f"t/T={t / TWO_PI:.6g}: {over}", budget=True)
             if traj.t[-1] < t - eps:
                 self._record(traj, t, y, info, sched(t - eps))
             traj.status = "completed"
@@ -316,7 +319,8 @@ class Simulation:
                 self._record(traj, t, y, info, sched(t - eps))
             traj.status = "failed"
             traj.message = str(stop)
-            if t < t_start + self.save_dt:  # stopped at once: say if it started in contact
+            if fresh and not stop.budget and t < t_start + self.save_dt:
+                # a fresh run that failed at once: say if it started in contact
                 traj.message += self._start_contact_hint(info_start)
         except (KeyboardInterrupt, SystemError) as exc:
             if isinstance(exc, SystemError) and not _caused_by_interrupt(exc):
@@ -356,7 +360,12 @@ def _caused_by_interrupt(exc) -> bool:
 
 
 class _Stop(Exception):
-    pass
+    """A run ends early; ``budget``: by numerics.max_steps / max_wall_time (not a failure of
+    the physics or the numerics)."""
+
+    def __init__(self, message: str, budget: bool = False):
+        super().__init__(message)
+        self.budget = budget
 
 
 class _deferred_sigint:

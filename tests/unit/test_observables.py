@@ -109,3 +109,12 @@ def test_torque_helpers():
     assert v == pytest.approx(tq[sel][np.argmax(np.abs(tq[sel]))]) and when >= 3.0
     assert o.plateau_value(t, np.r_[np.zeros(40), np.ones(10)], 0.8) == 1.0
     assert np.isnan(o.torque_peak(t, tq, start=10)[0])
+
+
+def test_cw_torque_peak_is_the_most_negative_value_after_the_switch():
+    from flagwrap.observables import cw_torque_peak
+
+    t = np.arange(0.0, 4.01, 0.5)
+    tq = np.array([0.9, 0.9, 0.9, 0.9, 0.9, -0.3, -0.7, -0.5, -0.6])  # switch at t = 2
+    assert cw_torque_peak(t, tq, 2.0) == (-0.7, 1.0)
+    assert np.isnan(cw_torque_peak(t, tq, 4.0)[0])

@@ -75,6 +75,9 @@ def test_other_sections_reject():
     with pytest.raises(UserInputError, match="not both"):
         CellBody(radius=0.05, radius_ratio=0.3)
     assert CellBody().radius_ratio == 0.6 and CellBody(radius=0.05).radius_ratio is None
+    import dataclasses  # replacing the default body's size by a radius still works
+
+    assert dataclasses.replace(CellBody(), radius=0.05) == CellBody(radius=0.05)
 
 
 def test_nonlocal_distance_of_a_tight_helix_is_the_pitch():

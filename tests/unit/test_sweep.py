@@ -377,3 +377,32 @@ def test_sweep_cli_rejects_a_bad_scheduler_and_a_binary_file(tmp_path, capsys):
     binary.write_bytes(b"\xff\xfe\x00bad")
     assert main(["sweep", str(binary), "--dry-run"]) == 2
     assert "not a UTF-8 text file" in capsys.readouterr().err
+
+
+def test_an_interrupted_sweep_of_a_changed_spec_shows_its_own_rows(tmp_path, fake, monkeypatch):
+    # the manifest is written when the sweep starts: killed after its first case, the new
+    # spec's finished row is shown and the old spec's rows are not
+    from flagwrap.sweep import runner as R
+    from flagwrap.sweep.runner import run_sweep
+    from flagwrap.sweep.store import SweepStore
+
+    def spec(tol):
+        return _spec(fake, grid={"psi_deg": [70.0], "turns": [2.0], "machin": [100.0, 200.0, 300.0]},
+                     base={"filament": {"n_beads": 21}, "numerics": {"tol": tol}})
+
+    run_sweep(spec(1e-4), tmp_path / "s", scheduler="synchronous")
+    real, calls = R.run_case, []
+
+    def dies_on_second(case, root):
+        if calls:
+            raise KeyboardInterrupt
+        calls.append(case)
+        return real(case, root)
+
+    monkeypatch.setattr(R, "run_case", dies_on_second)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(spec(1e-5), tmp_path / "s", scheduler="synchronous")
+    store = SweepStore(tmp_path / "s")
+    shown = list(store.iter_rows())
+    assert len(list(store.iter_rows(everything=True))) == 4
+    assert [r["key"] for r in shown] == [calls[0].key]

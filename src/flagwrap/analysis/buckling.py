@@ -68,6 +68,7 @@ import numpy as np
 
 from flagwrap.errors import UserInputError
 from flagwrap.observables import (
+    cw_torque_peak,
     free_end_height,
     local_handedness,
     near_body_fraction,
@@ -506,15 +507,7 @@ class BucklingAnalysis(_Compute):
         self.perversion_turns = float(t[i[0]] - self.waiting.switch_turns) if i.size else float("nan")
         if torque_reduced is not None:
             _, tq = _series(t, torque_reduced)
-            # the CW peak: the most negative torque strictly after the switch (the sample at
-            # t_s itself is still CCW), as paper_runs.torque_summary and Fig. 4(c) read it
-            cw = np.flatnonzero(t > self.waiting.switch_turns)
-            if cw.size:
-                j = int(cw[np.argmin(tq[cw])])
-                self.torque_peak = float(tq[j])
-                self.torque_peak_turns = float(t[j] - self.waiting.switch_turns)
-            else:
-                self.torque_peak = self.torque_peak_turns = float("nan")
+            self.torque_peak, self.torque_peak_turns = cw_torque_peak(t, tq, self.waiting.switch_turns)
             self.torque_final = plateau_value(t, tq, self.final.final_turns)
         else:
             self.torque_peak = self.torque_peak_turns = self.torque_final = float("nan")

@@ -98,6 +98,7 @@ def torque_summary(ds) -> dict:
     import numpy as np
 
     from flagwrap.analysis.buckling import find_switch
+    from flagwrap.observables import cw_torque_peak
 
     t = ds["turns"].values
     tq = ds["motor_torque_reduced"].values
@@ -105,14 +106,14 @@ def torque_summary(ds) -> dict:
     t_s = t[i - 1]
     ccw = (t > t_s - 1) & (t <= t_s)
     cw = t > t_s
-    j = int(np.argmin(np.where(cw, tq, np.inf)))
+    peak, peak_turns = cw_torque_peak(t, tq, t_s)
     first = cw & (t <= t_s + 1)
     early = cw & (t <= t_s + 2)
     k = int(np.argmin(np.where(early, tq, np.inf)))
     last = t > t[-1] - 1
     at = ds.attrs
     return {"machin": float(at["machin"]), "hydrodynamics": bool(at.get("hydrodynamics", 1)),
-            "ccw": float(np.median(tq[ccw])), "cw_peak": float(tq[j]), "cw_peak_turns": float(t[j] - t_s),
+            "ccw": float(np.median(tq[ccw])), "cw_peak": peak, "cw_peak_turns": peak_turns,
             "cw_first_turn": float(np.median(tq[first])),
             "cw_early_peak": float(tq[k]), "cw_early_peak_turns": float(t[k] - t_s), "cw_final": float(np.median(tq[last])),
             "state": str(at.get("analysis_state", "")),

@@ -26,7 +26,7 @@ from flagwrap.observables.handedness import (
     right_handed_fraction,
 )
 from flagwrap.observables.tip import free_end_height, tip_trajectory
-from flagwrap.observables.torque import plateau_value, reduced_torque, torque_peak
+from flagwrap.observables.torque import cw_torque_peak, plateau_value, reduced_torque, torque_peak
 from flagwrap.observables.winding import azimuth, winding_angle, winding_turns
 
 __all__ = [
@@ -44,6 +44,7 @@ __all__ = [
     "reduced_torque",
     "tip_trajectory",
     "torque_peak",
+    "cw_torque_peak",
     "winding_angle",
     "winding_turns",
 ]

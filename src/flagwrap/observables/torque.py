@@ -65,6 +65,19 @@ def torque_peak(turns, torque, start=-np.inf, stop=np.inf) -> tuple[float, float
     return float(v[i]), float(t[i])
 
 
+def cw_torque_peak(turns, torque, switch_turns: float) -> tuple[float, float]:
+    """The CW torque peak: the most negative torque strictly after the CCW -> CW switch
+    (the frame at ``switch_turns`` still belongs to the CCW phase), and its ``t/T`` after
+    the switch; ``(nan, nan)`` without CW frames. Paper Fig. 4(c): the peak ``N_m``."""
+    t = np.asarray(turns, dtype=float)
+    v = np.asarray(torque, dtype=float)
+    cw = np.flatnonzero(t > switch_turns)
+    if not cw.size:
+        return float("nan"), float("nan")
+    j = int(cw[np.argmin(v[cw])])
+    return float(v[j]), float(t[j] - switch_turns)
+
+
 def plateau_value(turns, values, last_turns=1.0) -> float:
     """Median of ``values`` over the last ``last_turns`` turns (a stationary value).
 

@@ -164,6 +164,19 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
             p = store.boundary / f"{k}.json"
             done.append(json.loads(p.read_text()) if p.is_file() else None)
         fn, args = run_geometry, (spec.boundary,)
+    def write_manifest():
+        row_keys = keys
+        if spec.mode == "boundary":  # the rows are the finished searches' test runs
+            row_keys = []
+            for c, k in zip(items, keys):
+                p = store.boundary / f"{k}.json"
+                res = json.loads(p.read_text()) if p.is_file() else {}
+                row_keys += [c.with_machin(r["machin"]).key for r in res.get("runs") or ()]
+        store.write_manifest(row_keys, keys if spec.mode == "boundary" else ())
+
+    # first: an interrupted sweep of a changed spec must not leave the old spec's rows current
+    # (grid: every key is known now; boundary: updated again at the end)
+    write_manifest()
     todo = [c for c, d in zip(items, done) if d is None or (retry_failed and not _ok(d))]
     report = SweepReport(root=Path(root), total=len(items), skipped=len(items) - len(todo))
     report.failed_before = [(k, d.get("error")) for k, d in zip(keys, done)
@@ -216,14 +229,7 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
     if bar is not None:
         bar.close()
     report.wall_time_s = time.perf_counter() - t0
-    row_keys = keys
-    if spec.mode == "boundary":  # the rows are the searches' test runs
-        row_keys = []
-        for c, k in zip(items, keys):
-            p = store.boundary / f"{k}.json"
-            res = json.loads(p.read_text()) if p.is_file() else {}
-            row_keys += [c.with_machin(r["machin"]).key for r in res.get("runs") or ()]
-    store.write_manifest(row_keys, keys if spec.mode == "boundary" else ())
+    write_manifest()
     report.table_path = store.export()
     return report
 

@@ -6,7 +6,9 @@ Layout of ``out/sweeps/<name>/``::
     rows/<key>.json        the case's row: parameters, status, class, t_c, error (atomic rename)
     boundary/<gkey>.json   boundary mode: M_c bracket of one geometry (atomic rename)
     critical/              boundary mode: the analysis.critical run cache of the searches
-    current.json           the row keys and geometry keys of the spec last run here: the
+    current.json           the row keys and geometry keys of the spec last run here
+                           (written when a sweep starts and again when it ends; boundary
+                           rows count once their geometry's search has finished): the
                            table, the boundaries and the diagram show those only
     table.parquet          the table of all rows, rewritten at the end of each sweep
                            (without pyarrow: table.nc, netCDF4, and table.csv)
