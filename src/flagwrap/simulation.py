@@ -246,12 +246,16 @@ class Simulation:
         fixed = not self.integrator.adaptive
         eps = 1e-12 * max(1.0, t_end)
         interrupted = _deferred_sigint()
+
+        def keep_last_state():
+            # (t, y, info) is consistent between steps: the run's last frame unless saved
+            if traj.t[-1] < t - eps:
+                self._record(traj, t, y, info, sched(t - eps))
+
         try:
             while t < t_end - eps:
                 if interrupted():
-                    # between steps the state is consistent: keep it as the last frame
-                    if traj.t[-1] < t - eps:
-                        self._record(traj, t, y, info, sched(t - eps))
+                    keep_last_state()
                     raise KeyboardInterrupt
                 k = sched.segment_index(t + eps)
                 seg = sched.segments[k]
@@ -310,13 +314,10 @@ class Simulation:
                         last_ck = _time.perf_counter()
                 if over:
                     raise _Stop(f"t/T={t / TWO_PI:.6g}: {over}", budget=True)
-            if traj.t[-1] < t - eps:
-                self._record(traj, t, y, info, sched(t - eps))
+            keep_last_state()
             traj.status = "completed"
         except _Stop as stop:
-            # (t, y, info) is the last good state on every path to here: keep it as a frame
-            if traj.t[-1] < t - eps:
-                self._record(traj, t, y, info, sched(t - eps))
+            keep_last_state()  # every path to here leaves (t, y, info) at the last good state
             traj.status = "failed"
             traj.message = str(stop)
             if fresh and not stop.budget and t < t_start + self.save_dt:
