@@ -56,7 +56,7 @@ def run(args) -> int:
         print(f"{spec.name}: {len(geos)} geometries, mode boundary, -> {root}")
         for c in geos:
             gk = geometry_key(c, spec.boundary)
-            done = (store.boundary / f"{gk}.json").is_file()
+            done = store.read_boundary(gk) is not None
             print(f"  {gk}  psi={c.psi_deg:5.1f} n={c.turns:4.2f} R/L={c.r_over_l:.4f} "
                   f"first M={spec.boundary['guess_ratio'] * c.machin_scaling:9.2f} hi={c.hi}  "
                   f"{'done' if done else 'todo'}")

@@ -22,7 +22,6 @@ goes on. The row is written by the process that ran the case, atomically
 from __future__ import annotations
 
 import importlib
-import json
 import math
 import os
 import socket
@@ -159,18 +158,14 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
 
         items = tuple(spec.geometries())
         keys = [_geometry_key(c, spec.boundary) for c in items]
-        done = []
-        for k in keys:
-            p = store.boundary / f"{k}.json"
-            done.append(json.loads(p.read_text()) if p.is_file() else None)
+        done = [store.read_boundary(k) for k in keys]
         fn, args = run_geometry, (spec.boundary,)
     def write_manifest():
         row_keys = keys
         if spec.mode == "boundary":  # the rows are the finished searches' test runs
             row_keys = []
             for c, k in zip(items, keys):
-                p = store.boundary / f"{k}.json"
-                res = json.loads(p.read_text()) if p.is_file() else {}
+                res = store.read_boundary(k) or {}
                 row_keys += [c.with_machin(r["machin"]).key for r in res.get("runs") or ()]
         store.write_manifest(row_keys, keys if spec.mode == "boundary" else ())
 

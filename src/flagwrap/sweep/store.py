@@ -88,6 +88,10 @@ class SweepStore:
         """Write ``row`` (must hold ``key``) atomically to ``rows/<key>.json``."""
         return write_json_atomic(jsonable(row), self.row_path(row["key"]))
 
+    def read_boundary(self, gkey: str) -> dict | None:
+        p = self.boundary / f"{gkey}.json"
+        return json.loads(p.read_text()) if p.is_file() else None
+
     def write_boundary(self, gkey: str, result: dict) -> Path:
         return write_json_atomic(jsonable(result), self.boundary / f"{gkey}.json")
 
@@ -112,7 +116,7 @@ class SweepStore:
 
     def iter_rows(self, everything: bool = False):
         """The current spec's complete rows, sorted by key (all rows on disk if
-        ``everything`` or if no spec has finished here yet)."""
+        ``everything`` or if no sweep has started here yet)."""
         if not self.rows.is_dir():
             return
         keep = None if everything else self._current("rows")
