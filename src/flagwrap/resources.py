@@ -46,6 +46,7 @@ class Estimate:
     output_memory: float
     linalg_memory: float
     file_bytes: float
+    unknowns: int  # ny: 3 (N - 2) bead coordinates + (N - 3) twists + the motor angle
 
     @property
     def memory(self) -> float:
@@ -71,10 +72,10 @@ def estimate(config) -> Estimate:
     turns = total_turns(config)
     n_saves = turns / num.save_every + 2.0
     frame = 8 * (3 * N + 3 * (N - 1) + (N - 1) + 8)
-    ny = 4 * N - 7  # free coordinates: 3 (N - 2) beads + (N - 3) twists + the motor angle
+    ny = 4 * N - 7  # free coordinates (Estimate.unknowns)
     dense = num.hydrodynamics and _dense_solver(num.linear_solver, ny)
     linalg = 5.0 * 8.0 * ny * ny if dense else 200.0 * 8.0 * ny
-    return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame)
+    return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame, ny)
 
 
 def _parse_bytes(text: str) -> float:
@@ -131,7 +132,7 @@ def check_memory(config, limit: float | None = None) -> Estimate:
                  f"filament.n_beads={N} beads need {_gb(est.output_memory)}; shorten "
                  "motor.protocol turns, increase numerics.save_every or reduce filament.n_beads")
     else:
-        cause = (f"dense linear algebra for filament.n_beads={N} ({4 * N - 7} unknowns) needs "
+        cause = (f"dense linear algebra for filament.n_beads={N} ({est.unknowns} unknowns) needs "
                  f"{_gb(est.linalg_memory)}; reduce filament.n_beads, use numerics.linear_solver = "
                  "\"auto\" or \"krylov\" (matrix-free), or switch numerics.hydrodynamics off")
     raise UserInputError(f"run would need about {_gb(est.memory)} of memory, more than the limit "
