@@ -217,8 +217,9 @@ class CellBody:
     """Rigid cell body: a cylinder of radius ``R_cell`` capped below by a hemisphere.
 
     Give either ``radius`` [m] or ``radius_ratio = R / R_cell`` (default 0.6, the paper's coil
-    helices: SI Fig. S7); both, with a ratio other than the default, is an error. ``cylinder_length`` [m] defaults to ``5 R_cell`` (the experiment's
-    25 cm cylinder of 5 cm radius). The fluid passes through the body (paper, Methods); only a
+    helices: SI Fig. S7); both, with a ratio other than the default, is an error.
+    ``cylinder_length`` [m] defaults to ``5 R_cell`` (the experiment's 25 cm cylinder of 5 cm
+    radius). The fluid passes through the body (paper, Methods); only a
     short-ranged repulsion keeps beads outside. ``enabled = false`` removes it altogether.
     """
 
