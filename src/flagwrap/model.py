@@ -27,7 +27,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from flagwrap import _system_kernels as SK
-from flagwrap import units
 from flagwrap.body.cell_body import CappedCylinder, NoBody
 from flagwrap.elasticity.rod import Frames, RestState, initial_frames, rest_state
 from flagwrap.geometry.helix import filament_positions
@@ -116,13 +115,13 @@ class RodSystem:
             )
         else:
             self.body = body or NoBody()
-        # gravity/buoyancy: force per bead (core units), along -z
+        # gravity/buoyancy: force per bead (core units) along +z, G l / L for a bead carrying
+        # contour l (half a bond at the ends): units.gravity_number
         self.gravity = np.zeros((N, 3))
         if fil.density is not None:
-            dm = (fil.density - config.fluid.density) * units.G_ACCEL * math.pi * fil.cross_section_radius**2
-            per_bead = np.full(N, fil.bond_length)
-            per_bead[0] = per_bead[-1] = 0.5 * fil.bond_length
-            self.gravity[:, 2] = -dm * per_bead / self.scales.force
+            per_bead = np.full(N, b)
+            per_bead[0] = per_bead[-1] = 0.5 * b
+            self.gravity[:, 2] = config.gravity_number * per_bead
         self.schedule = Schedule(config.motor.protocol)
         self._colors = None
 

@@ -74,6 +74,11 @@ class Filament:
         number of beads ``N >= 5`` (paper: 61). Bond length ``b = L / (N - 1)``.
     density : float or None
         filament density [kg m^-3]; ``None`` means density-matched (no gravity).
+    density_mismatch : float or None
+        the density as a fraction of the fluid's, ``(rho - rho_f) / rho_f`` in (-1, inf)
+        (``-0.02``: 2 % lighter than the fluid, buoyant); an alternative to ``density``,
+        resolved to it by :class:`Config` (which knows ``rho_f``). ``Config.gravity_number``
+        is the dimensionless buoyancy ``G`` (docs/gravity.md).
     hydrodynamic_radius : float or None
         bead radius used in the mobility [m]; ``None`` means ``a`` (the paper's choice).
     stretch_stiffness : float
@@ -93,6 +98,7 @@ class Filament:
     density: float | None = None
     hydrodynamic_radius: float | None = None
     stretch_stiffness: float = 1000.0
+    density_mismatch: float | None = None
 
     def __post_init__(self):
         L = _positive("filament.length", self.length, "m")
@@ -154,6 +160,16 @@ class Filament:
             raise UserInputError(f"filament.n_beads must be in [5, 200000], got {self.n_beads}")
         if self.density is not None:
             _positive("filament.density", self.density, "kg/m^3")
+        if self.density_mismatch is not None:
+            if self.density is not None:
+                raise UserInputError(
+                    f"filament: give density ({self.density!r} kg/m^3) or density_mismatch "
+                    f"({self.density_mismatch!r}), not both")
+            m = _finite("filament.density_mismatch", self.density_mismatch)
+            if not m > -1.0:
+                raise UserInputError(
+                    f"filament.density_mismatch = (rho - rho_f)/rho_f must be > -1 (-100 %: a "
+                    f"filament of zero density), got {m!r}")
         if self.hydrodynamic_radius is not None:
             ah = _positive("filament.hydrodynamic_radius", self.hydrodynamic_radius, "m")
             if ah >= R:
@@ -511,6 +527,21 @@ class Config:
             if not isinstance(getattr(self, attr), cls):
                 raise UserInputError(f"config.{attr} must be a {cls.__name__}")
         fil = self.filament
+        if fil.density_mismatch is not None:
+            # resolved to a density here, where the fluid's is known (as pitch-like inputs
+            # are resolved to the pitch): the stored config holds the density only
+            rho = self.fluid.density * (1.0 + float(fil.density_mismatch))
+            if not rho > 0:
+                raise UserInputError(
+                    f"filament.density_mismatch={fil.density_mismatch!r} with fluid.density="
+                    f"{self.fluid.density!r} kg/m^3 gives no positive filament density; give "
+                    "filament.density instead")
+            import copy
+
+            fil = copy.copy(fil)  # a copy: the caller's Filament may serve other configs
+            _set(fil, "density", rho)
+            _set(fil, "density_mismatch", None)
+            _set(self, "filament", fil)
         # beads that are not contour neighbours must not overlap in the stress-free helix
         from flagwrap.geometry.helix import min_nonlocal_distance
 
@@ -564,6 +595,25 @@ class Config:
         return units.reynolds_number(
             self.fluid.density, self.filament.helix_radius, self.omega, self.fluid.viscosity
         )
+
+    @property
+    def density_mismatch(self) -> float:
+        """``(rho - rho_f) / rho_f`` of the filament (0 when density-matched or
+        ``fluid.density = 0``)."""
+        rho = self.filament.density
+        if rho is None or self.fluid.density == 0:
+            return 0.0
+        return (rho - self.fluid.density) / self.fluid.density
+
+    @property
+    def gravity_number(self) -> float:
+        """``G = (rho_f - rho) g pi a^2 L^3 / A`` (:func:`flagwrap.units.gravity_number`):
+        > 0 buoyant (compresses the hanging filament), 0 density-matched."""
+        fil = self.filament
+        if fil.density is None:
+            return 0.0
+        return units.gravity_number(self.fluid.density - fil.density, fil.cross_section_radius,
+                                    fil.length, fil.bending_modulus)
 
     @property
     def machin_critical_scaling(self) -> float:

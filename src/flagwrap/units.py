@@ -55,6 +55,20 @@ def reynolds_number(density: float, radius: float, omega: float, viscosity: floa
     return density * radius**2 * omega / viscosity
 
 
+def gravity_number(delta_density: float, radius: float, length: float, bending: float) -> float:
+    """Gravity number ``G = (rho_f - rho) g pi a^2 L^3 / A`` (dimensionless).
+
+    ``delta_density = rho_f - rho`` [kg m^-3]: positive for a filament lighter than the fluid
+    (buoyant), whose net force points up, toward the clamp of a filament hanging below the
+    motor, and so compresses it. ``G`` is the buoyant weight per length ``q`` in units of
+    ``A / L^3``; a straight clamped-free column so loaded toward its clamp buckles at
+    ``q L^3 / A = 7.837`` (Greenhill 1881; Timoshenko & Gere, *Theory of Elastic Stability*,
+    2nd ed., section 2.13). In core units the force on a bead carrying contour ``l`` is
+    ``G l / L`` along ``+z`` (force unit ``A / L^2``).
+    """
+    return delta_density * G_ACCEL * math.pi * radius**2 * length**3 / bending
+
+
 @dataclass(frozen=True)
 class Scales:
     """Reference scales of one run.

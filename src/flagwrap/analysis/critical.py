@@ -458,6 +458,7 @@ class CriticalSearch:
             "relative_uncertainty": self.relative_uncertainty,
             "omega_c": self.omega_c, "frequency_c": self.frequency_c,
             "machin_critical_scaling": float(self._cfg.machin_critical_scaling),
+            "gravity_number": float(self._cfg.gravity_number),
             "monotone": self.monotone, "params": self.params(),
             "runs": [dataclasses.asdict(r) for r in self._runs],
         }

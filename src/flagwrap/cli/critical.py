@@ -59,7 +59,8 @@ def run(args) -> int:
     if not args.json:
         print(f"{args.config}: critical search (rtol {args.rtol:g}, {args.ccw_turns:g} CCW + "
               f"{args.cw_turns:g} CW turns, HI {'on' if cfg.numerics.hydrodynamics else 'off'}); "
-              f"scaling-line M_c = {cfg.machin_critical_scaling:.1f}", flush=True)
+              f"scaling-line M_c = {cfg.machin_critical_scaling:.1f}; gravity number G = "
+              f"{cfg.gravity_number:.4g}", flush=True)
     search.compute(cfg, guess=args.guess, bracket=args.bracket)
     s = search.summary()
     if args.json:

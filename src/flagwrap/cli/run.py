@@ -91,6 +91,7 @@ def run(args) -> int:
         print(f"flagwrap run: resuming from {ckpt} at t/T = {resume.t / (2 * math.pi):.4g} "
               f"({resume.n_steps} steps done)", file=sys.stderr)
     print(f"flagwrap run {cfg.name}: M = {cfg.machin:.4g}, Re = {cfg.reynolds:.3g}, "
+          f"G = {cfg.gravity_number:.4g}{_mismatch(cfg)}, "
           f"omega/omega_c (scaling) = {cfg.omega_ratio_scaling:.3g}, N = {cfg.filament.n_beads}, "
           f"HI {'on' if cfg.numerics.hydrodynamics else 'off'}", file=sys.stderr)
     from flagwrap.simulation import RunInterrupted
@@ -119,3 +120,10 @@ def run(args) -> int:
         print(f"flagwrap run: run stopped: {traj.message} (partial output kept in {out})", file=sys.stderr)
         return 1
     return 0
+
+
+def _mismatch(cfg) -> str:
+    """`` (density mismatch -2 %)`` where the filament is not density-matched."""
+    if cfg.filament.density is None:
+        return ""
+    return f" (density mismatch {100 * cfg.density_mismatch:+.3g} %)"

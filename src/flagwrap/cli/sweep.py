@@ -58,7 +58,7 @@ def run(args) -> int:
             gk = geometry_key(c, spec.boundary)
             done = store.read_boundary(gk) is not None
             print(f"  {gk}  psi={c.psi_deg:5.1f} n={c.turns:4.2f} R/L={c.r_over_l:.4f} "
-                  f"first M={spec.boundary['guess_ratio'] * c.machin_scaling:9.2f} hi={c.hi}  "
+                  f"first M={spec.boundary['guess_ratio'] * c.machin_scaling:9.2f}{_gravity(c)} hi={c.hi}  "
                   f"{'done' if done else 'todo'}")
         return 0
     if args.dry_run:
@@ -66,7 +66,7 @@ def run(args) -> int:
         for c in spec.cases:
             row = store.read_row(c.key)
             print(f"  {c.key}  psi={c.psi_deg:5.1f} n={c.turns:4.2f} R/L={c.r_over_l:.4f} "
-                  f"M={c.machin:9.2f} (x{c.omega_ratio_scaling:.3g} scaling) hi={c.hi}  "
+                  f"M={c.machin:9.2f} (x{c.omega_ratio_scaling:.3g} scaling){_gravity(c)} hi={c.hi}  "
                   f"{row['status'] + ' ' + str(row.get('state')) if row else 'todo'}")
         return 0
     rep = run_sweep(spec, root, scheduler=args.scheduler, n_workers=args.workers,
@@ -82,8 +82,17 @@ def run(args) -> int:
             print(f"  FAILED {key}: {err}")
     if spec.mode == "boundary":
         for b in store.boundaries():
-            print(f"  psi={b['psi_deg']:5.1f} n={b['turns']:4.2f} R/L={b['r_over_l']:.4f} "
+            grav = (f" density_mismatch={b['density_mismatch']:+.4g} G={b.get('gravity_number', 0.0):.4g}"
+                    if b.get("density_mismatch") is not None else "")
+            print(f"  psi={b['psi_deg']:5.1f} n={b['turns']:4.2f} R/L={b['r_over_l']:.4f}{grav} "
                   f"M_c={fmt_float(b.get('machin_c'), '.1f')} bracket={b.get('bracket')} "
                   f"converged={b.get('converged')} status={b['status']}")
     print(f"table: {rep.table_path}")
     return 0 if rep.failed == 0 and not rep.failed_before else 1
+
+
+def _gravity(case) -> str:
+    """`` mismatch=... G=...`` for a case with a density mismatch (gravity number beside M)."""
+    if case.density_mismatch is None:
+        return ""
+    return f" mismatch={case.density_mismatch:+.4g} G={case.gravity_number:.4g}"

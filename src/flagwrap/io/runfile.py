@@ -23,7 +23,8 @@ max_bond_strain        (time)                 max |l/l0 - 1|
 
 Global attributes: ``flagwrap_version``, ``format_version``, ``config_toml`` (the full input,
 re-loadable), ``status`` ("completed" or "failed"), ``message``, ``machin`` (M), ``reynolds``,
-``omega_ratio_scaling`` (M / (0.06 (R/L)^-3)), scales, step counts and wall time. Files are
+``gravity_number`` (G = (rho_f - rho) g pi a^2 L^3 / A, > 0 buoyant), ``density_mismatch``
+((rho - rho_f) / rho_f), ``omega_ratio_scaling`` (M / (0.06 (R/L)^-3)), scales, step counts and wall time. Files are
 written to a temporary name, flushed, fsynced and renamed, so a crash never leaves a
 half-written file under the final name.
 """
@@ -81,6 +82,8 @@ def trajectory_dataset(traj):
             "message": traj.message,
             "machin": cfg.machin,
             "reynolds": cfg.reynolds,
+            "gravity_number": cfg.gravity_number,
+            "density_mismatch": cfg.density_mismatch,
             "omega_ratio_scaling": cfg.omega_ratio_scaling,
             "machin_critical_scaling": cfg.machin_critical_scaling,
             "omega": sc.omega,

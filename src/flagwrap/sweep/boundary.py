@@ -64,7 +64,8 @@ def run_geometry(case: Case, root, boundary: dict) -> dict:
         return res
 
     out = {"gkey": gkey, **case.geometry(), "r_over_l_cubed": case.r_over_l ** 3,
-           "machin_scaling": case.machin_scaling, "boundary": dict(boundary)}
+           "machin_scaling": case.machin_scaling, "gravity_number": case.gravity_number,
+           "boundary": dict(boundary)}
     try:
         search = CriticalSearch(rtol=boundary["rtol"], cw_turns=case.run["cw_turns"],
                                 ccw_turns=case.run["ccw_turns"], factor=boundary["factor"],
@@ -88,7 +89,9 @@ def run_geometry(case: Case, root, boundary: dict) -> dict:
 
 
 GEOMETRY_COLUMNS = ("psi_deg", "turns", "r_over_l", "r_over_rcell", "hi", "n_beads",
-                    "ccw_turns", "cw_turns")
+                    "ccw_turns", "cw_turns", "density_mismatch")
+#: values of columns that rows written before the column existed lack
+_COLUMN_DEFAULTS = {"density_mismatch": 0.0}
 
 
 def brackets_from_rows(rows) -> list[dict]:
@@ -111,7 +114,8 @@ def brackets_from_rows(rows) -> list[dict]:
     for r in rows:
         if r.get("status") != "ok" or r.get("buckled") is None:
             continue
-        g = tuple(round(float(r[c]), 9) if isinstance(r[c], float) else r[c] for c in GEOMETRY_COLUMNS)
+        v = [r.get(c, _COLUMN_DEFAULTS.get(c)) for c in GEOMETRY_COLUMNS]
+        g = tuple(round(float(x), 9) if isinstance(x, float) else x for x in v)
         groups.setdefault(g, []).append(r)
     out = []
     for g, rs in groups.items():

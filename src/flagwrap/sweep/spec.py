@@ -8,6 +8,10 @@ A sweep file names the cases by the dimensionless numbers of the paper's Fig. 5:
 * speed: ``machin`` (M = eta omega L^4 / A) or ``omega_ratio_scaling`` = omega / omega_c with
   omega_c from the paper's scaling line, ``M = omega_ratio_scaling * 0.06 (R/L)^-3``.
 * ``hi``: hydrodynamic interactions on/off.
+* ``density_mismatch``: the filament's ``(rho - rho_f) / rho_f`` (default: density-matched,
+  no gravity); ``-0.02`` is 2 % lighter than the fluid, buoyant. With the fixed L below the
+  gravity number ``G = (rho_f - rho) g pi a^2 L^3 / A`` is the same for every geometry at a
+  given mismatch: ``G = -929.8 x mismatch`` (docs/gravity.md).
 
 Every case becomes an SI :class:`~flagwrap.params.Config` with the paper's material
 (a = 1.5 mm, E = 1.5 MPa, nu = 0.49, eta = 1.1 Pa s) and a **fixed** arclength L = 0.4 m, so
@@ -78,7 +82,7 @@ BASE_CONFIG = {
 
 GEOMETRY_KEYS = ("psi_deg", "turns", "r_over_l")
 SPEED_KEYS = ("machin", "omega_ratio_scaling")
-CASE_KEYS = GEOMETRY_KEYS + ("r_over_rcell",) + SPEED_KEYS + ("hi",)
+CASE_KEYS = GEOMETRY_KEYS + ("r_over_rcell",) + SPEED_KEYS + ("hi", "density_mismatch")
 RUN_DEFAULTS = {"ccw_turns": 5.0, "cw_turns": 10.0, "stop_after": 2.0}
 BOUNDARY_DEFAULTS = {"rtol": 0.1, "guess_ratio": 2.0, "factor": 2.0, "max_runs": 10}
 
@@ -145,6 +149,8 @@ class Case:
         M = eta omega L^4 / A.
     hi : bool
         hydrodynamic interactions on.
+    density_mismatch : float or None
+        ``(rho - rho_f) / rho_f`` of the filament; None: density-matched (no gravity).
     run : dict
         ``ccw_turns``, ``cw_turns``, ``stop_after`` (None = full run).
     base : dict
@@ -160,6 +166,7 @@ class Case:
     run: dict = field(default_factory=lambda: dict(RUN_DEFAULTS))
     base: dict = field(default_factory=dict)
     runner: str | None = None
+    density_mismatch: float | None = None
 
     @property
     def machin_scaling(self) -> float:
@@ -172,8 +179,11 @@ class Case:
 
     def geometry(self) -> dict:
         """The case without its speed (the key of a boundary search)."""
-        return {"psi_deg": self.psi_deg, "turns": self.turns, "r_over_l": self.r_over_l,
-                "r_over_rcell": self.r_over_rcell, "hi": self.hi}
+        g = {"psi_deg": self.psi_deg, "turns": self.turns, "r_over_l": self.r_over_l,
+             "r_over_rcell": self.r_over_rcell, "hi": self.hi}
+        if self.density_mismatch is not None:  # absent: the keys of density-matched sweeps stay
+            g["density_mismatch"] = self.density_mismatch
+        return g
 
     def with_machin(self, machin: float) -> "Case":
         import dataclasses
@@ -192,10 +202,14 @@ class Case:
         d["body"] = {k: v for k, v in d["body"].items() if k != "radius"}
         d["body"]["radius_ratio"] = self.r_over_rcell
         d["numerics"]["hydrodynamics"] = bool(self.hi)
+        if self.density_mismatch is not None:
+            fil.pop("density", None)
+            fil["density_mismatch"] = float(self.density_mismatch)
         d["motor"] = {"machin": self.machin, "protocol": [
             {"direction": "ccw", "turns": float(self.run["ccw_turns"])},
             {"direction": "cw", "turns": float(self.run["cw_turns"])}]}
-        d["name"] = f"psi{self.psi_deg:.3g}_n{self.turns:.3g}_M{self.machin:.5g}"
+        d["name"] = f"psi{self.psi_deg:.3g}_n{self.turns:.3g}_M{self.machin:.5g}" + (
+            "" if self.density_mismatch is None else f"_dm{self.density_mismatch:+.4g}")
         return d
 
     def config(self):
@@ -230,7 +244,14 @@ class Case:
                 "omega_ratio_scaling": self.omega_ratio_scaling, "hi": bool(self.hi),
                 "n_beads": int(_merge(BASE_CONFIG, self.base)["filament"]["n_beads"]),
                 "ccw_turns": float(self.run["ccw_turns"]), "cw_turns": float(self.run["cw_turns"]),
-                "stop_after": self.run.get("stop_after")}
+                "stop_after": self.run.get("stop_after"),
+                "density_mismatch": 0.0 if self.density_mismatch is None else float(self.density_mismatch),
+                "gravity_number": self.gravity_number}
+
+    @property
+    def gravity_number(self) -> float:
+        """``G = (rho_f - rho) g pi a^2 L^3 / A`` of the case's config (0: density-matched)."""
+        return self.config().gravity_number if self.density_mismatch is not None else 0.0
 
 
 @dataclass(frozen=True)
@@ -289,7 +310,17 @@ def _make_case(p: dict, run: dict, base: dict, mode: str, where: str, runner=Non
         machin = float(v) if speeds[0] == "machin" else float(v) * scaling_machin(rl)
     else:
         machin = scaling_machin(rl)
-    return Case(psi, n, rl, float(rr), machin, hi, dict(run), copy.deepcopy(base), runner)
+    dm = p.get("density_mismatch")
+    if dm is not None:
+        if isinstance(dm, bool) or not isinstance(dm, (int, float)) or not (math.isfinite(dm) and dm > -1):
+            raise UserInputError(f"{where}: density_mismatch = (rho - rho_f)/rho_f must be a finite "
+                                 f"number > -1 (-100 %: zero density), got {dm!r}")
+        dm = float(dm)
+        clash = [k for k in ("density", "density_mismatch") if k in (base.get("filament") or {})]
+        if clash:
+            raise UserInputError(f"sweep: [base] filament.{clash[0]} and the case key "
+                                 "density_mismatch both set the filament density; keep one")
+    return Case(psi, n, rl, float(rr), machin, hi, dict(run), copy.deepcopy(base), runner, dm)
 
 
 def _table(data: dict, key: str) -> dict:
