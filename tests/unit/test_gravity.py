@@ -120,3 +120,85 @@ def test_sweep_axis_rejects(grid, base, needle):
         data["base"] = base
     with pytest.raises(UserInputError, match=needle):
         spec_from_dict(data)
+
+
+def _fake_sweeps(tmp_path):
+    """A boundary store over the mismatch (Fig. 4(a) helix) and a Fig. 5 store whose rows
+    follow M_c = c_k (R/L)^-3 with a known c_k per mismatch."""
+    from flagwrap.sweep.store import SweepStore
+
+    a = SweepStore(tmp_path / "g4a")
+    for i, (dm, mc) in enumerate([(-0.04, None), (-0.02, 380.0), (0.0, 576.0), (0.02, 700.0)]):
+        G = -929.8 * dm
+        b = {"psi_deg": 70.47, "turns": 2.0, "r_over_l": 0.075, "density_mismatch": dm,
+             "gravity_number": G, "status": "ok"}
+        if mc is None:
+            b.update(bracket=[None, 35.0], machin_c=None, converged=False)
+        else:
+            b.update(bracket=[mc / 1.02, mc * 1.02], machin_c=mc, converged=True)
+        a.write_boundary(f"g{i}", b)
+    f5 = SweepStore(tmp_path / "g5")
+    truth = {-0.02: 0.1, 0.0: 0.3}
+    for dm, c in truth.items():
+        for rl in (0.03, 0.05, 0.08):
+            mc = c * rl ** -3
+            for q in (0.9, 1.1):
+                f5.write_row({"key": f"{dm}-{rl}-{q}", "status": "ok", "psi_deg": 70.0, "turns": 2.0,
+                              "r_over_l": rl, "r_over_rcell": 0.6, "hi": True, "n_beads": 31,
+                              "ccw_turns": 5.0, "cw_turns": 10.0, "machin": q * mc, "buckled": q > 1,
+                              "state": "folding" if q > 1 else "stable", "density_mismatch": dm,
+                              "gravity_number": -929.8 * dm})
+    return a.root, f5.root, truth
+
+
+def test_gravity_figure_from_sweeps(tmp_path):
+    import json
+
+    from flagwrap.plotting.gravity import boundary_table, diagram_fits, gravity_figure
+
+    g4a, g5, truth = _fake_sweeps(tmp_path)
+    tab = boundary_table(g4a)
+    assert [r["kind"] for r in tab] == ["upper", "bracket", "bracket", "bracket"]
+    fits = diagram_fits(g5)
+    assert [f["density_mismatch"] for f in fits] == [-0.02, 0.0]
+    for f in fits:  # the rows of one mismatch are fitted alone
+        assert f["fit"]["prefactor_beta3"] == pytest.approx(truth[f["density_mismatch"]], rel=0.02)
+    paths = gravity_figure(tmp_path / "fig", g4a, g5, static_G=(0.0, 2.0))
+    assert {p.rsplit(".", 1)[1] for p in paths} == {"png", "pdf", "json"}
+    info = json.loads((tmp_path / "fig" / "gravity.json").read_text())
+    assert info["static"]["tip_height"][0] == 0.0 and info["static"]["tip_height"][1] > 0  # floats up
+    # flagwrap bacteria reads the density-matched fit back from it
+    from flagwrap.cli.bacteria import load_model_boundary
+
+    assert load_model_boundary(tmp_path / "fig" / "gravity.json")["prefactor_beta3"] == pytest.approx(0.3, rel=0.02)
+
+
+def test_bacteria_model_boundary_errors(tmp_path):
+    from flagwrap.cli.bacteria import load_model_boundary
+
+    for text in ("not json", "{}", '{"fit": {"prefactor_beta3": -1}}'):
+        p = tmp_path / "b.json"
+        p.write_text(text)
+        with pytest.raises(UserInputError, match="--model-boundary"):
+            load_model_boundary(p)
+    with pytest.raises(UserInputError, match="not found"):
+        load_model_boundary(tmp_path / "none.json")
+
+
+def test_static_equilibrium_is_where_the_time_loop_ends():
+    # the Newton equilibrium (static_buckling) and the overdamped dynamics with the motor at rest
+    # share only the force code: both must end in the same shape (HI off for speed; the end
+    # state does not depend on the mobility). 20 turns at M = 1 are ~30 relaxation times of the
+    # slowest mode (rate ~1 / turn), so the run is converged to << 1e-6 L; bound 1e-6 L.
+    from flagwrap.analysis.static_buckling import static_branch, with_gravity_number
+    from flagwrap.simulation import Simulation
+
+    d = make_config(machin=1.0, hi=False).to_dict()
+    d["filament"]["n_beads"] = 31
+    d["motor"] = {"machin": 1.0, "protocol": [{"direction": "stop", "turns": 20.0}]}
+    cfg = config_from_dict(d)
+    br = static_branch(cfg, [0.0, 4.0, 8.0])
+    assert np.all(np.diff(br.tip_height) > 0) and np.all(br.lowest_eigenvalue > 0)
+    traj = Simulation(with_gravity_number(cfg, 8.0)).run()
+    assert traj.ok, traj.message
+    assert traj.arrays()["x"][-1, -1, 2] == pytest.approx(br.tip_z[-1], abs=1e-6)

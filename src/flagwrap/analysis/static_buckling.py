@@ -207,3 +207,61 @@ def critical_gravity(config, G_lo: float, G_hi: float, rtol: float = 1e-4, strai
         else:
             G_hi = G
     return 0.5 * (G_lo + G_hi), G_lo, G_hi
+
+
+@dataclass
+class StaticBranch:
+    """Equilibria of a filament along increasing ``G`` (:func:`static_branch`).
+
+    ``G``, ``tip_height`` (free end's z minus its z at G = 0, in L: the quantity the buckling
+    criterion of docs/analysis.md thresholds at 0.15), ``tip_z``, ``tip_offset`` (distance from
+    the body axis, L) and ``lowest_eigenvalue`` (core units) per point; the branch ends early
+    where Newton finds no equilibrium near the previous one (``message``).
+    """
+
+    G: np.ndarray
+    tip_z: np.ndarray
+    tip_height: np.ndarray
+    tip_offset: np.ndarray
+    lowest_eigenvalue: np.ndarray
+    message: str = ""
+
+    def crossing(self, rise: float = 0.15) -> float:
+        """The ``G`` at which the static rise of the free end first reaches ``rise`` (linear
+        interpolation); nan if it does not within the branch."""
+        h = self.tip_height
+        above = np.nonzero(h >= rise)[0]
+        if not len(above) or above[0] == 0:
+            return math.nan
+        i = above[0]
+        return float(self.G[i - 1] + (rise - h[i - 1]) * (self.G[i] - self.G[i - 1]) / (h[i] - h[i - 1]))
+
+
+def static_branch(config, G_values, straight: bool = False, max_iter: int = 200) -> StaticBranch:
+    """Continue the static equilibrium of ``config``'s filament (motor at rest) through the
+    increasing gravity numbers ``G_values`` (each solve starts from the previous one)."""
+    from flagwrap.model import RodSystem
+
+    G_values = np.asarray(sorted(float(g) for g in G_values))
+    out = {k: [] for k in ("G", "tip_z", "tip_offset", "lowest")}
+    prev, z0, msg = None, None, ""
+    for G in G_values:
+        cfg = with_gravity_number(config, G)
+        s = straight_rod_system(cfg) if straight else RodSystem(cfg)
+        try:
+            e = equilibrium(s, *((prev.y, prev.base) if prev is not None else (None, None)),
+                            max_iter=max_iter)
+        except RuntimeError as exc:
+            msg = f"G = {G:g}: {exc}"
+            break
+        x, _, _ = s.unpack(e.y)
+        if z0 is None:
+            z0 = s.x0[-1, 2]
+        out["G"].append(G)
+        out["tip_z"].append(x[-1, 2])
+        out["tip_offset"].append(math.hypot(x[-1, 0], x[-1, 1]))
+        out["lowest"].append(e.eigenvalues[0])
+        prev = e
+    tip_z = np.array(out["tip_z"])
+    return StaticBranch(np.array(out["G"]), tip_z, tip_z - (z0 if z0 is not None else 0.0),
+                        np.array(out["tip_offset"]), np.array(out["lowest"]), msg)

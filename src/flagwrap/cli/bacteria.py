@@ -16,6 +16,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--prefactor", type=float, default=0.06, help="c in M_c = c (R/L)^-3 (default 0.06)")
     parser.add_argument("--sources", action="store_true", help="also list every parameter's source and status")
     parser.add_argument("--csv", action="store_true", help="machine-readable CSV instead of the table")
+    parser.add_argument("--model-boundary", metavar="JSON", default=None,
+                        help="also place each species against THIS model's density-matched (G = 0) "
+                             "boundary, read from `flagwrap figure gravity`'s gravity.json (its 0 %% "
+                             "mismatch fit) or `flagwrap figure fig5`'s fig5.json (docs/gravity.md)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -47,6 +51,9 @@ def run(args: argparse.Namespace) -> int:
                   f"Any one of these would put it on the boundary: eta = {need['viscosity_pa_s'] * 1e3:.3g} mPa s, "
                   f"f = {need['frequency_hz']:.3g} Hz, n = {need['n_flagella']:.3g}, L = {need['length_um']:.3g} um, "
                   f"R = {need['radius_um']:.3g} um, prefactor c = {need['prefactor']:.3g}.")
+    if args.model_boundary is not None:
+        print()
+        print(format_model_boundary(species, load_model_boundary(args.model_boundary), args.model_boundary))
     if args.sources:
         for s in species:
             print(f"\n[{s.key}] {s.name} ({s.form})")
@@ -54,3 +61,55 @@ def run(args: argparse.Namespace) -> int:
                 val = getattr(s, fname)
                 print(f"  {fname:<20} {str(val):<10} {p.status:<10} {p.source}" + (f" -- {p.note}" if p.note else ""))
     return 0
+
+
+def load_model_boundary(path) -> dict:
+    """The density-matched fit ``{prefactor, exponent, prefactor_beta3, ...}`` from a
+    gravity.json (entry with ``density_mismatch == 0``) or a fig5.json (``fit``)."""
+    import json
+    import math
+    from pathlib import Path
+
+    from flagwrap.errors import UserInputError
+
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text())
+    except FileNotFoundError:
+        raise UserInputError(f"--model-boundary: file not found: {p}") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise UserInputError(f"--model-boundary: {p} is not a JSON file: {exc}") from None
+    fit = None
+    if isinstance(doc, dict) and isinstance(doc.get("fig5"), list):
+        fit = next((f.get("fit") for f in doc["fig5"] if f.get("density_mismatch") == 0), None)
+    elif isinstance(doc, dict) and isinstance(doc.get("fit"), dict):
+        fit = doc["fit"]
+    ok = isinstance(fit, dict) and isinstance(fit.get("prefactor_beta3"), (int, float)) \
+        and math.isfinite(fit["prefactor_beta3"]) and fit["prefactor_beta3"] > 0
+    if not ok:
+        raise UserInputError(f"--model-boundary: {p} has no density-matched boundary fit (expected "
+                             "gravity.json with a 0 % mismatch diagram, or fig5.json)")
+    return fit
+
+
+def format_model_boundary(species, fit: dict, source) -> str:
+    """Each species' M against this model's fitted boundary (beta = 3 fixed, and free beta)."""
+    import math
+
+    c3 = fit["prefactor_beta3"]
+    c, beta = fit.get("prefactor"), fit.get("exponent")
+    free = isinstance(c, (int, float)) and isinstance(beta, (int, float)) and math.isfinite(c) and math.isfinite(beta)
+    head = f"{'species':<34} {'M':>8} {'M/M_c paper':>11} {'M/M_c model':>11}" + (f" {'(free beta)':>11}" if free else "") + "  side (model)"
+    lines = [f"This model's density-matched boundary ({source}): M_c = {c3:.3g} (R/L)^-3"
+             + (f"; free fit M_c = {c:.3g} (R/L)^-{beta:.2f}" if free else "")
+             + ". Measured at a/L = 1/267 (the paper's helices), extrapolated to the bacteria's own "
+               "R/L: an inference, not a simulation of each species.", head, "-" * len(head)]
+    for s in species:
+        rl = s.radius_um / s.length_um
+        r3 = s.machin / (c3 * rl ** -3)
+        label = f"{s.name[:25]} ({s.form})"
+        row = f"{label:<34} {s.machin:>8.4g} {s.instability_ratio(0.06):>11.3g} {r3:>11.3g}"
+        if free:
+            row += f" {s.machin / (c * rl ** -beta):>11.3g}"
+        lines.append(row + f"  {'unstable' if r3 > 1 else 'stable'}")
+    return "\n".join(lines)

@@ -10,6 +10,9 @@ Figures (registry FIGURES, extended as figures are added):
   fig6  waiting time t_c/T against eps with 0.5/eps, the fit and a log-log inset (the
         Fig. 4(a) helix, n = 2: flagwrap.analysis.paper_runs.FIG6_GEOMETRY)
   figS7 free-end height for several omega with t_c marked (SI Fig. S7(a), same helix)
+  gravity  M_c of the Fig. 4(a) helix against the buoyancy G (flagwrap sweep
+        examples/sweeps/gravity-fig4a.toml), its static rise at M = 0, and the Fig. 5 fit per
+        density mismatch (examples/sweeps/gravity-fig5.toml); docs/gravity.md
 
 Example::
 
@@ -32,6 +35,12 @@ def _fig5(outdir):
     return fig5(outdir)
 
 
+def _gravity(outdir):
+    from flagwrap.plotting.gravity import gravity_figure
+
+    return gravity_figure(outdir)
+
+
 def _paper(name):
     def build(outdir):
         from flagwrap.plotting import figures
@@ -50,6 +59,8 @@ FIGURES = {
     "figS7": _paper("figS7"),
     # issue 5: stability diagram from the sweep rows (out/sweeps/fig5, else fig5-quick)
     "fig5": _fig5,
+    # issue 18: the threshold against the buoyancy, from the gravity sweeps
+    "gravity": _gravity,
 }
 
 

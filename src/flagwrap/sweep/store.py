@@ -41,9 +41,11 @@ def write_json_atomic(obj, path) -> Path:
 
 
 def jsonable(obj):
-    """NaN/inf -> None, numpy scalars -> Python, recursively."""
+    """NaN/inf -> None, numpy scalars and arrays -> Python, recursively."""
     if isinstance(obj, dict):
         return {str(k): jsonable(v) for k, v in obj.items()}
+    if hasattr(obj, "tolist") and getattr(obj, "ndim", 0) > 0:  # a numpy array
+        obj = obj.tolist()
     if isinstance(obj, (list, tuple)):
         return [jsonable(v) for v in obj]
     if hasattr(obj, "item") and not isinstance(obj, (str, bytes)):
