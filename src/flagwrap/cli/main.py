@@ -54,7 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from flagwrap.errors import UserInputError
+    from flagwrap.errors import OutputWriteError, UserInputError
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -63,6 +63,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(args._module.run(args) or 0)
+    except OutputWriteError as exc:  # the work is done and kept elsewhere: not an input error
+        print(f"flagwrap {args.command}: error: {exc}", file=sys.stderr)
+        return 1
     except UserInputError as exc:
         print(f"flagwrap {args.command}: error: {exc}", file=sys.stderr)
         return 2

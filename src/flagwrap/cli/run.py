@@ -66,9 +66,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from flagwrap.errors import UserInputError
-    from flagwrap.io.runfile import write_run
     from flagwrap.resources import check_disk, check_memory
-    from flagwrap.simulation import simulate
 
     cfg = load(args)
     out = Path(args.output or f"out/{cfg.name}.nc")
@@ -87,6 +85,47 @@ def run(args) -> int:
         check_compatible(resume, cfg, ckpt)
     check_memory(cfg)
     check_disk(cfg, out, checkpoint=ckpt is not None)
+    from flagwrap.io.outputs import check_output_file, output_lock
+
+    check_output_file(out, "output (-o)")
+    if ckpt is not None:
+        check_output_file(ckpt, "checkpoint")
+        if ckpt.resolve() == out.resolve():
+            raise UserInputError(f"--checkpoint {ckpt} is the output file itself; give another path")
+    if args.figure:
+        from flagwrap.plotting.summary import figure_suffixes
+
+        check_output_file(args.figure, "--figure", suffixes=figure_suffixes())
+    with output_lock(out, ckpt):
+        return _simulate(args, cfg, out, ckpt, resume)
+
+
+def _completed_run_at(path) -> bool:
+    """Whether ``path`` holds a readable run file with ``status = "completed"``."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            return str(f.attrs.get("status", "")) == "completed"
+    except Exception:
+        return False
+
+
+def _simulate(args, cfg, out, ckpt, resume) -> int:
+    import math
+
+    from flagwrap.io.outputs import write_or_rescue
+    from flagwrap.io.runfile import write_run
+    from flagwrap.simulation import simulate
+
+    keep = out.exists() and _completed_run_at(out)
+
+    def write_partial(traj):
+        # a failed or interrupted run never replaces a completed run file: it goes beside it
+        target = out.with_name(f"{out.stem}.partial{out.suffix}") if keep else out
+        write_or_rescue(lambda p: write_run(traj, p), target, "partial run")
+        return target
+
     if resume is not None:
         print(f"flagwrap run: resuming from {ckpt} at t/T = {resume.t / (2 * math.pi):.4g} "
               f"({resume.n_steps} steps done)", file=sys.stderr)
@@ -101,23 +140,28 @@ def run(args) -> int:
                         checkpoint_every_steps=args.checkpoint_every,
                         checkpoint_every_seconds=args.checkpoint_seconds)
     except RunInterrupted as stop:
-        write_run(stop.trajectory, out)
+        target = write_partial(stop.trajectory)
         print(f"flagwrap run: run stopped: {stop.trajectory.message} (partial output kept in "
-              f"{out}{'; --resume continues from the last checkpoint' if ckpt is not None else ''})",
-              file=sys.stderr)
+              f"{target}{'; --resume continues from the last checkpoint' if ckpt is not None else ''}"
+              f"{f'; the completed {out} is unchanged' if target != out else ''})", file=sys.stderr)
         return 130
-    write_run(traj, out)
+    if traj.ok:
+        write_or_rescue(lambda p: write_run(traj, p), out, "run file")
+    else:
+        out_written = write_partial(traj)
     if traj.ok and ckpt is not None and ckpt.exists():
         ckpt.unlink()  # the run file now holds everything
-    print(f"wrote {out} ({traj.status}, {traj.n_steps} steps, {traj.wall_time:.1f} s)", file=sys.stderr)
+    written = out if traj.ok else out_written
+    print(f"wrote {written} ({traj.status}, {traj.n_steps} steps, {traj.wall_time:.1f} s)", file=sys.stderr)
     if args.figure:
         from flagwrap.io.runfile import read_run
         from flagwrap.plotting.summary import summary_figure
 
-        summary_figure(read_run(out), args.figure)
+        summary_figure(read_run(written), args.figure)
         print(f"wrote {args.figure}", file=sys.stderr)
     if not traj.ok:
-        print(f"flagwrap run: run stopped: {traj.message} (partial output kept in {out})", file=sys.stderr)
+        print(f"flagwrap run: run stopped: {traj.message} (partial output kept in {out_written}"
+              f"{f'; the completed {out} is unchanged' if out_written != out else ''})", file=sys.stderr)
         return 1
     return 0
 

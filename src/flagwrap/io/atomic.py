@@ -111,3 +111,15 @@ def atomic_write(path, write, sync_dir: bool = False) -> Path:
         if os.path.exists(tmp):
             os.unlink(tmp)
     return path
+
+
+def read_error(path, what: str, exc: BaseException) -> str:
+    """One-line message for a file that could not be read: a failed checksum (HDF5's
+    Fletcher-32 filter reports "filter returned failure" / "checksum") is called corrupt, any
+    other error unreadable (truncated, not HDF5)."""
+    text = " ".join(str(exc).split())  # one line
+    low = text.lower()
+    if "filter returned failure" in low or "checksum" in low or "differ from their checksummed" in low:
+        return (f"{path} is corrupt: it fails its checksum ({text}); the file is left as it "
+                f"is, re-create it")
+    return f"{path} is not a readable {what} (truncated, damaged or not netCDF4/HDF5): {text}"

@@ -67,6 +67,12 @@ class Checkpoint:
         return Frames(self.base_t.copy(), self.base_d1.copy(), self.base_rt.copy())
 
 
+def _checked(group, name, data):
+    """A float64 dataset with the Fletcher-32 filter (chunked; an empty one cannot be)."""
+    a = np.asarray(data, dtype=np.float64)
+    group.create_dataset(name, data=a, fletcher32=a.size > 0)
+
+
 def write_checkpoint(ckpt: Checkpoint, path) -> Path:
     """Write ``ckpt`` to ``path`` atomically (temporary file, fsync, rename, fsync folder)."""
     import h5py
@@ -79,11 +85,14 @@ def write_checkpoint(ckpt: Checkpoint, path) -> Path:
             f.attrs["config_toml"] = ckpt.config_toml
             for k, typ in _SCALARS.items():
                 f.attrs[k] = np.float64(getattr(ckpt, k)) if typ is float else np.int64(getattr(ckpt, k))
+            # every array carries HDF5's Fletcher-32 checksum, verified by h5py on read; the
+            # scalars are also stored as one checksummed array and compared with the attributes
+            _checked(f, "scalars", [float(getattr(ckpt, k)) for k in _SCALARS])
             for k in ("y", "base_t", "base_d1", "base_rt"):
-                f.create_dataset(k, data=np.asarray(getattr(ckpt, k), dtype=np.float64))
+                _checked(f, k, getattr(ckpt, k))
             g = f.create_group("records")
             for k in RECORD_NAMES:
-                g.create_dataset(k, data=np.asarray(ckpt.records[k], dtype=np.float64))
+                _checked(g, k, ckpt.records[k])
 
     return atomic_write(path, write, sync_dir=True)
 
@@ -113,8 +122,16 @@ def read_checkpoint(path) -> Checkpoint:
             for k in ("y", "base_t", "base_d1", "base_rt"):
                 kw[k] = np.array(f[k][()], dtype=np.float64)
             kw["records"] = {k: np.array(f["records"][k][()], dtype=np.float64) for k in RECORD_NAMES}
+            if "scalars" in f and not np.array_equal(
+                    f["scalars"][()], np.array([float(kw[k]) for k in _SCALARS])):
+                raise ValueError("scalar attributes differ from their checksummed copy")
         except (KeyError, OSError, ValueError, TypeError) as exc:
-            raise UserInputError(f"{path} is an incomplete or damaged checkpoint ({exc})") from None
+            from flagwrap.io.atomic import read_error
+
+            msg = read_error(path, "checkpoint", exc)
+            if " is corrupt: " not in msg:
+                msg = f"{path} is an incomplete or damaged checkpoint ({exc})"
+            raise UserInputError(msg) from None
     ck = Checkpoint(**kw)
     n = len(ck.records["t"])
     if n == 0 or any(len(v) != n for v in ck.records.values()):

@@ -111,7 +111,15 @@ def write_dataset_atomic(ds, path) -> Path:
     """Write an xarray dataset to ``path`` atomically (see :mod:`flagwrap.io.atomic`)."""
     from flagwrap.io.atomic import atomic_write
 
-    return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf"))
+    return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf", encoding=checksummed(ds)))
+
+
+def checksummed(ds) -> dict:
+    """netCDF encoding that puts HDF5's Fletcher-32 checksum filter on every non-scalar
+    variable (verified by HDF5 on every read: a corrupt chunk is a read error)."""
+    return {k: {"fletcher32": True} for k, v in ds.variables.items()
+            if v.ndim > 0 and v.size > 0 and v.dtype.kind in "biufc"}  # HDF5 filters need
+    # fixed-size numbers (the string labels of the xyz axis are variable-length)
 
 
 def write_run(traj, path) -> Path:
@@ -128,8 +136,10 @@ def read_run(path):
         raise UserInputError(f"run file not found: {path}")
     try:
         ds = xr.load_dataset(path, engine="h5netcdf", phony_dims="sort")
-    except Exception as exc:  # truncated / not HDF5
-        raise UserInputError(f"{path} is not a readable run file (truncated or not netCDF4): {exc}") from None
+    except Exception as exc:  # truncated / not HDF5 / a checksum mismatch
+        from flagwrap.io.atomic import read_error
+
+        raise UserInputError(read_error(path, "run file", exc)) from None
     fv = ds.attrs.get("format_version")
     if fv is None or "config_toml" not in ds.attrs:
         raise UserInputError(f"{path} is not a flagwrap run file (no format_version/config)")

@@ -5,6 +5,13 @@ from __future__ import annotations
 from pathlib import Path
 
 
+def figure_suffixes() -> set:
+    """File suffixes matplotlib can save (``.png``, ``.pdf``, ``.svg``, ...)."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return {f".{k}" for k in FigureCanvasBase.get_supported_filetypes()}
+
+
 def summary_figure(ds, path):
     """Two panels: ``(z(L) - z(0))/L`` and ``N_m R / A`` against ``t/T`` (paper Fig. 4(c),(d))."""
     import matplotlib

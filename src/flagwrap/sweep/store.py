@@ -186,4 +186,7 @@ def _to_netcdf(df, path):
                 d[c] = ["" if v is None else str(v) for v in d[c]]
     if "key" in d.columns:
         d = d.set_index("key")
-    xr.Dataset.from_dataframe(d).to_netcdf(path, engine="h5netcdf")
+    from flagwrap.io.runfile import checksummed
+
+    ds = xr.Dataset.from_dataframe(d)
+    ds.to_netcdf(path, engine="h5netcdf", encoding=checksummed(ds))
