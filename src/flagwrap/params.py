@@ -21,6 +21,16 @@ from flagwrap.errors import UserInputError
 
 #: prefactor of the paper's stability line M_c = 0.06 (R/L)^-3 (main text, Fig. 5)
 PAPER_MC_PREFACTOR = 0.06
+#: validity bounds of the bead model (docs/robustness.md): the filament is slender
+#: (L >= 10 a; the paper's helices have L/a ~ 270, flagella ~ 700), and its beads are close
+#: enough to act as one body: a chain's drag per length 6 pi eta a / b (no HI) equals a slender
+#: filament's ~4 pi eta / (ln(L/a) + 0.5) near b ~ 9 a and is ~10x too small at b = 100 a, the
+#: bound (the paper's N = 61 helix has b = 4.4 a; coarse test chains up to ~70 a)
+MIN_SLENDERNESS = 10.0
+MAX_BOND_OVER_RADIUS = 100.0
+#: the cell body is wider than the filament and not absurdly larger than it:
+#: 2 a < R_cell <= 10 L
+MAX_BODY_OVER_LENGTH = 10.0
 
 
 def _finite(name: str, value) -> float:
@@ -177,8 +187,19 @@ class Filament:
                     f"filament.hydrodynamic_radius={ah:g} m must be < helix_radius={R:g} m"
                 )
         _positive("filament.stretch_stiffness", self.stretch_stiffness, "(units of A/b^3)")
-        if L <= 2 * a:
-            raise UserInputError(f"filament.length={L:g} m must exceed 2 a = {2 * a:g} m")
+        if L < MIN_SLENDERNESS * a:
+            raise UserInputError(
+                f"filament.length={L:g} m is {L / a:.3g} x cross_section_radius={a:g} m; a Kirchhoff "
+                f"rod needs a slender filament, length >= {MIN_SLENDERNESS:g} a")
+        b = L / (self.n_beads - 1)
+        if b > MAX_BOND_OVER_RADIUS * a:
+            need = L / (MAX_BOND_OVER_RADIUS * a) + 1
+            fix = (f"raise n_beads to >= {math.ceil(need)}" if need <= 200_000 else
+                   "no allowed n_beads resolves it: check length and cross_section_radius")
+            raise UserInputError(
+                f"filament: bond length L/(n_beads - 1) = {b:.3g} m is {b / a:.3g} x "
+                f"cross_section_radius={a:g} m, more than {MAX_BOND_OVER_RADIUS:g}: beads that far apart "
+                f"are separate spheres, not a filament (their drag per length falls as a/b); {fix}")
 
     # derived -------------------------------------------------------------------------------
     @property
@@ -542,6 +563,16 @@ class Config:
             _set(fil, "density", rho)
             _set(fil, "density_mismatch", None)
             _set(self, "filament", fil)
+        if self.body.enabled:
+            rc = self.body.resolved_radius(fil.helix_radius)
+            a = fil.cross_section_radius
+            if not 2 * a < rc <= MAX_BODY_OVER_LENGTH * fil.length:
+                how = ("body.radius" if self.body.radius is not None else
+                       f"body.radius_ratio = {self.body.radius_ratio:g} (R / R_cell)")
+                raise UserInputError(
+                    f"{how} gives a cell body of radius {rc:.3g} m; it must be wider than the "
+                    f"filament (> 2 a = {2 * a:.3g} m) and at most {MAX_BODY_OVER_LENGTH:g} L = "
+                    f"{MAX_BODY_OVER_LENGTH * fil.length:.3g} m (or set body.enabled = false)")
         # beads that are not contour neighbours must not overlap in the stress-free helix
         from flagwrap.geometry.helix import min_nonlocal_distance
 

@@ -25,7 +25,10 @@ def test_speed_and_size_parsing():
     from flagwrap.plotting.movies import parse_size, parse_speed
 
     assert parse_speed("100x") == 100 and parse_speed("2.5") == 2.5 and parse_speed("auto") is None
-    assert parse_size("1000x570") == (992, 576)
+    assert parse_size("1024x576") == (1024, 576) and parse_size((160, 96)) == (160, 96)
+    for bad, near in (("1000x570", "992x576"), ("13x7", "160x96"), ("100000x100000", "7680x4320")):
+        with pytest.raises(UserInputError, match=f"nearest allowed: {near}"):  # never resized silently
+            parse_size(bad)
     for bad in ("fast", "-3x", "0x"):
         with pytest.raises(UserInputError):
             parse_speed(bad)
@@ -77,8 +80,8 @@ def test_bad_movie_and_snapshot_outputs_are_one_line_errors(tiny_run, tmp_path, 
     from flagwrap.cli.main import main
 
     assert main(["movie", str(tiny_run), "-o", str(tmp_path / "m.png")]) == 2
-    assert "must end in .mp4 or .gif" in capsys.readouterr().err
+    assert "unknown suffix '.png'; allowed: .gif, .mp4" in capsys.readouterr().err
     assert main(["snapshots", str(tiny_run), "-o", str(tmp_path / "s.png"), "--formats", "xyz"]) == 2
     assert "--formats: xyz not supported" in capsys.readouterr().err
     assert main(["snapshots", str(tiny_run), "-o", str(tmp_path / "s.png"), "--dpi", "0"]) == 2
-    assert "--dpi must be >= 1" in capsys.readouterr().err
+    assert "--dpi must be in [1, 1200]" in capsys.readouterr().err

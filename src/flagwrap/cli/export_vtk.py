@@ -24,6 +24,12 @@ def run(args) -> int:
     from flagwrap.io.runfile import read_run
     from flagwrap.io.vtk import export_vtk
 
+    from flagwrap.errors import UserInputError
+    from flagwrap.io.outputs import check_output_dir
+
+    check_output_dir(args.directory, "export folder")
+    if args.stride < 1:
+        raise UserInputError(f"--stride must be >= 1, got {args.stride}")
     ds = read_run(args.run_file)
     pvd = export_vtk(ds, args.directory, time_unit=args.time, stride=args.stride,
                      with_forces=not args.no_forces)

@@ -70,6 +70,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from flagwrap.io.outputs import check_output_dir
+
+    check_output_dir(args.outdir, "figure folder (-o)")
     for path in FIGURES[args.name](args.outdir):
         print(path)
     return 0

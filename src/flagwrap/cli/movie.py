@@ -11,6 +11,10 @@ Examples::
 
 from __future__ import annotations
 
+#: limits of the options (a movie frame takes ~0.2 s to render)
+MAX_FPS = 240.0
+MAX_FRAMES = 100_000
+
 
 def add_arguments(p):
     p.add_argument("run_file", help="run file (.nc) written by `flagwrap run`")
@@ -30,11 +34,24 @@ def run(args) -> int:
     from flagwrap.plotting.movies import (movie_times, parse_size, parse_speed,
                                           write_movie)
 
-    ds = read_run(args.run_file)
+    import math
+
+    from flagwrap.errors import UserInputError
+    from flagwrap.io.outputs import check_output_file
+
     out = Path(args.output) if args.output else Path(args.run_file).with_suffix(".mp4")
+    if out.suffix == "":
+        out = out.with_suffix(".mp4")
+    check_output_file(out, "movie (-o)", suffixes={".mp4", ".gif"})
+    if not (math.isfinite(args.fps) and 0 < args.fps <= MAX_FPS):
+        raise UserInputError(f"--fps must be in (0, {MAX_FPS}], got {args.fps}")
     speed = parse_speed(args.speed)
     size = parse_size(args.size)
+    ds = read_run(args.run_file)
     n = len(movie_times(ds["time"].values, args.fps, speed))
+    if n > MAX_FRAMES:
+        raise UserInputError(f"the movie would have {n} frames (more than {MAX_FRAMES}, ~{n / 5 / 3600:.2g} "
+                             f"h of rendering): raise --speed or lower --fps")
     bar = None
     if not args.quiet:
         from tqdm import tqdm

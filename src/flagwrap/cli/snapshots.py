@@ -40,8 +40,17 @@ def run(args) -> int:
     if bad:
         raise UserInputError(f"--formats: {', '.join(bad)} not supported; choose from "
                              f"{', '.join(sorted(known))}")
-    if args.dpi < 1:
-        raise UserInputError(f"--dpi must be >= 1, got {args.dpi}")
+    if not 1 <= args.dpi <= 1200:
+        raise UserInputError(f"--dpi must be in [1, 1200], got {args.dpi}")
+    if not 1 <= args.n <= 50:
+        raise UserInputError(f"-n must be in [1, 50] snapshots, got {args.n}")
+    from flagwrap.io.outputs import check_output_file
+
+    for f in formats:
+        check_output_file(out.with_suffix("." + f), "snapshot file (-o)")
+    if args.times is not None:
+        if len(args.times) > 50:
+            raise UserInputError(f"-t/--times: at most 50 times, got {len(args.times)}")
     paths = write_snapshots(ds, out, formats=formats, dpi=args.dpi, times=args.times, n=args.n)
     for p in paths:
         print(p)

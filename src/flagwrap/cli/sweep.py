@@ -47,7 +47,10 @@ def run(args) -> int:
                              f"address like tcp://HOST:PORT, got {sched!r}")
     if args.workers is not None and args.workers < 1:
         raise UserInputError(f"--workers must be >= 1, got {args.workers}")
+    from flagwrap.io.outputs import check_output_dir
+
     root = Path(args.out) / spec.name
+    check_output_dir(root, "sweep folder (--out)")
     store = SweepStore(root)
     if args.dry_run and spec.mode == "boundary":
         from flagwrap.sweep.boundary import geometry_key

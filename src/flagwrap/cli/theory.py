@@ -9,6 +9,10 @@ Actions:
 
 from __future__ import annotations
 
+#: bound of --points (each point solves the helix's force balance; 1e5 points take ~1 s and
+#: ~100 MB; a curve needs a few hundred)
+MAX_POINTS = 100_000
+
 import argparse
 
 
@@ -57,8 +61,8 @@ def run(args: argparse.Namespace) -> int:
     from flagwrap.cli.triangulate import write_csv
     from flagwrap.theory.stretching import StretchedHelix
 
-    if args.points < 2:
-        raise UserInputError("--points must be >= 2")
+    if not 2 <= args.points <= MAX_POINTS:
+        raise UserInputError(f"--points must be in [2, {MAX_POINTS}], got {args.points}")
     b = None if args.b == args.a else args.b
     h = StretchedHelix(args.radius, args.pitch, args.length, args.youngs_modulus, args.poisson, args.a, b)
     psi = np.linspace(h.psi0, math.radians(5.0), args.points)

@@ -278,6 +278,14 @@ def fit_rod_viscosity(
         r = target - design @ coef
         cov = cov * float(r @ r) / (L.size - design.shape[1])
     err = np.sqrt(np.diag(cov))
+    if not coef[0] > 0:
+        raise UserInputError(
+            f"the fit gives a viscosity eta = {coef[0]:.3g} Pa s <= 0: the forces do not grow with "
+            "the immersed length as drag does (the buoyancy term exceeds the measured force; check "
+            "the sign of F, --fluid-density and the units)")
+    if fit_density and not coef[1] > 0:
+        raise UserInputError(f"the fit gives a fluid density {coef[1]:.3g} kg/m^3 <= 0: fix the "
+                             "density instead (drop --fit-density)")
     if fit_density:
         return RodFit(float(coef[0]), float(err[0]), float(coef[1]), float(err[1]))
     return RodFit(float(coef[0]), float(err[0]), float(fluid_density), 0.0)

@@ -49,17 +49,30 @@ def parse_speed(text) -> float | None:
     return val
 
 
+#: frame size limits [pixel]: the layout needs 160 x 96; 7680 x 4320 (8K) bounds the memory
+#: of one RGB frame (~100 MB) and of the encoder
+MIN_SIZE, MAX_SIZE = (160, 96), (7680, 4320)
+
+
 def parse_size(text) -> tuple[int, int]:
-    """``"WxH"`` in pixels, each rounded to a multiple of 16 (at least 160 x 96)."""
-    if isinstance(text, (tuple, list)):
+    """``"WxH"`` in pixels: multiples of 16 (the H.264 macro block) within
+    :data:`MIN_SIZE` .. :data:`MAX_SIZE`; anything else is an error naming the nearest
+    allowed size (nothing is resized silently)."""
+    if isinstance(text, (tuple, list)) and len(text) == 2:
         w, h = text
     else:
         m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", str(text))
         if not m:
             raise UserInputError(f"size must look like 1024x576, got {text!r}")
         w, h = int(m.group(1)), int(m.group(2))
-    w, h = max(160, 16 * round(int(w) / 16)), max(96, 16 * round(int(h) / 16))
-    return int(w), int(h)
+    w, h = int(w), int(h)
+    ok = [MIN_SIZE[i] <= v <= MAX_SIZE[i] and v % 16 == 0 for i, v in enumerate((w, h))]
+    if not all(ok):
+        near = [min(MAX_SIZE[i], max(MIN_SIZE[i], 16 * round(v / 16))) for i, v in enumerate((w, h))]
+        raise UserInputError(f"size {w}x{h}: width and height must be multiples of 16 within "
+                             f"{MIN_SIZE[0]}x{MIN_SIZE[1]} .. {MAX_SIZE[0]}x{MAX_SIZE[1]}; nearest "
+                             f"allowed: {near[0]}x{near[1]}")
+    return w, h
 
 
 def movie_times(time: np.ndarray, fps: float, speed: float | None = None) -> np.ndarray:
@@ -264,18 +277,36 @@ def write_movie(ds, path, fps: float = 25.0, speed=None, size=DEFAULT_SIZE, prog
     gif = path.suffix.lower() == ".gif" or not ffmpeg_available()
     if gif:
         path = path.with_suffix(".gif")
+    # rendered into a temporary file beside the target and renamed in when complete: an
+    # interrupted or failed movie never replaces an existing one
+    import os
+    import tempfile
+
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    final, path = path, Path(tmp)
+    if gif:
         writer = iio.get_writer(path, mode="I", duration=1000.0 / fps, loop=0)
     else:
         writer = iio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264",
                                 pixelformat="yuv420p", quality=7, macro_block_size=16,
                                 ffmpeg_log_level="error")
     n = len(frames)
+    done = False
     try:
         for k in range(n):
             writer.append_data(frames.render(k))
             if progress is not None:
                 progress(k + 1, n)
+        done = True
     finally:
         writer.close()
         frames.close()
-    return path
+        if done:
+            from flagwrap.io.atomic import _UMASK
+
+            os.chmod(path, 0o666 & ~_UMASK)  # mkstemp made it 0600
+            os.replace(path, final)
+        elif path.exists():
+            path.unlink()
+    return final

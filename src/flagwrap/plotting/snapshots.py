@@ -50,7 +50,7 @@ def frame_indices(ds, times) -> np.ndarray:
     turns = ds["turns"].values
     times = np.atleast_1d(np.asarray(times, float))
     tol = 0.5 * float(np.median(np.diff(turns))) if len(turns) > 1 else 0.0
-    bad = times[(times < turns[0] - tol) | (times > turns[-1] + tol)]
+    bad = times[~np.isfinite(times) | (times < turns[0] - tol) | (times > turns[-1] + tol)]
     if len(bad):
         raise UserInputError(
             f"snapshot time(s) t/T = {', '.join(f'{b:g}' for b in bad)} outside the run "

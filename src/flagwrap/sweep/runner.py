@@ -123,7 +123,19 @@ def open_client(scheduler, n_workers=None):
         cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1,
                                processes=True, dashboard_address=":0")
         return Client(cluster), cluster
-    return Client(scheduler), None
+    try:
+        return Client(scheduler, timeout=CONNECT_TIMEOUT_S), None
+    except (OSError, TimeoutError) as exc:  # CommClosedError is an OSError
+        from flagwrap.errors import UserInputError
+
+        raise UserInputError(f"--scheduler {scheduler}: no Dask scheduler answered within "
+                             f"{CONNECT_TIMEOUT_S:g} s ({type(exc).__name__}: "
+                             f"{' '.join(str(exc).split())[:200]}); start one (`dask scheduler`) or "
+                             "use --scheduler local") from None
+
+
+#: how long to wait for a remote scheduler before giving up with a message
+CONNECT_TIMEOUT_S = 10.0
 
 
 def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_failed=False,
@@ -169,10 +181,14 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
                 row_keys += [c.with_machin(r["machin"]).key for r in res.get("runs") or ()]
         store.write_manifest(row_keys, keys if spec.mode == "boundary" else ())
 
+    todo = [c for c, d in zip(items, done) if d is None or (retry_failed and not _ok(d))]
+    client = cluster = None
+    if todo and scheduler != "synchronous":
+        # connect before anything is written: an unreachable scheduler changes nothing
+        client, cluster = open_client(scheduler, n_workers)
     # first: an interrupted sweep of a changed spec must not leave the old spec's rows current
     # (grid: every key is known now; boundary: updated again at the end)
     write_manifest()
-    todo = [c for c, d in zip(items, done) if d is None or (retry_failed and not _ok(d))]
     report = SweepReport(root=Path(root), total=len(items), skipped=len(items) - len(todo))
     report.failed_before = [(k, d.get("error")) for k, d in zip(keys, done)
                             if d is not None and not _ok(d) and not retry_failed]
@@ -201,7 +217,6 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
     elif todo:
         from dask.distributed import as_completed
 
-        client, cluster = open_client(scheduler, n_workers)
         try:
             futs = {client.submit(fn, c, str(store.root), *args, pure=False): c for c in todo}
             for fut in as_completed(list(futs)):

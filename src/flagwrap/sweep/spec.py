@@ -84,6 +84,8 @@ GEOMETRY_KEYS = ("psi_deg", "turns", "r_over_l")
 SPEED_KEYS = ("machin", "omega_ratio_scaling")
 CASE_KEYS = GEOMETRY_KEYS + ("r_over_rcell",) + SPEED_KEYS + ("hi", "density_mismatch")
 RUN_DEFAULTS = {"ccw_turns": 5.0, "cw_turns": 10.0, "stop_after": 2.0}
+#: the most cases one sweep file may expand to (checked before the grid is expanded)
+MAX_CASES = 100_000
 BOUNDARY_DEFAULTS = {"rtol": 0.1, "guess_ratio": 2.0, "factor": 2.0, "max_runs": 10}
 
 
@@ -286,6 +288,12 @@ def _expand(table: dict, where: str) -> list[dict]:
         if not v:
             raise UserInputError(f"{where}.{k} is an empty list")
     keys = list(lists)
+    n = math.prod(len(v) for v in lists.values())
+    if n > MAX_CASES:
+        raise UserInputError(f"{where}: {' x '.join(str(len(lists[k])) for k in keys)} = {n} cases, "
+                             f"more than {MAX_CASES} (at ~1 min per case that is "
+                             f"{n / (60 * 24 * 2):.3g} days on 2 cores); split "
+                             "the sweep or use mode = \"boundary\"")
     return [dict(zip(keys, combo)) for combo in itertools.product(*(lists[k] for k in keys))]
 
 
