@@ -26,24 +26,32 @@ import dataclasses
 import functools
 from pathlib import Path
 
-# geometry -> (example config, search settings); docs/critical.md records the results
+# geometry -> (built-in case, flagwrap.cases; equal to examples/<name>.toml, search settings);
+# docs/critical.md records the results. Built-in, so the figures work from any directory and
+# from a wheel install.
 SEARCHES = {
-    "fig4a": ("examples/fig4a.toml", {"rtol": 0.1, "bracket": (283.0, 600.0)}),
+    "fig4a": ("fig4a", {"rtol": 0.1, "bracket": (283.0, 600.0)}),
     # guess: the scaling line 0.06 (R/L)^-3 = 480 times the fig4a ratio M_c / scaling = 4.03
-    "movie7": ("examples/movie7.toml", {"rtol": 0.1, "guess": 1930.0}),
+    "movie7": ("movie7", {"rtol": 0.1, "guess": 1930.0}),
 }
 FIG4_RATIOS = (0.85, 2.05)
 FIG6_EPS = (0.1, 0.25, 0.5, 1.0, 2.0)
 FIG6_GEOMETRY = "fig4a"
 
 
-def _config(name, root="."):
+def _config(name, root=None):
+    """The geometry's config: the built-in case (``root``: a folder whose
+    ``examples/<case>.toml`` to read instead, for a modified checkout)."""
+    if root is None:
+        from flagwrap.cases import get_case
+
+        return get_case(SEARCHES[name][0])
     from flagwrap.io.config import load_config
 
-    return load_config(Path(root) / SEARCHES[name][0])
+    return load_config(Path(root) / "examples" / f"{SEARCHES[name][0]}.toml")
 
 
-def critical(name: str, cache_dir="out/critical", on_run=None, root="."):
+def critical(name: str, cache_dir="out/critical", on_run=None, root=None):
     """The documented :class:`~flagwrap.analysis.critical.CriticalSearch` of geometry ``name``."""
     from flagwrap.analysis.critical import CriticalSearch, RunCache
 
@@ -58,7 +66,7 @@ def no_hi(cfg):
     return cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
 
 
-def fig4_runs(machin_c: float, cache_dir="out/paper", ratios=FIG4_RATIOS, on_run=None, root="."):
+def fig4_runs(machin_c: float, cache_dir="out/paper", ratios=FIG4_RATIOS, on_run=None, root=None):
     """``{(ratio, hydrodynamics): run file path}`` of the Fig. 4 helix (full 10 + 10 protocol)."""
     from flagwrap.analysis.critical import RunCache, probe_config, simulate_and_analyse
 
@@ -75,7 +83,7 @@ def fig4_runs(machin_c: float, cache_dir="out/paper", ratios=FIG4_RATIOS, on_run
     return out
 
 
-def fig6_runs(machin_c: float, cache_dir="out/waiting", eps_values=FIG6_EPS, on_run=None, root="."):
+def fig6_runs(machin_c: float, cache_dir="out/waiting", eps_values=FIG6_EPS, on_run=None, root=None):
     """Rows of :func:`~flagwrap.analysis.waiting_time.waiting_time_sweep` plus ``path``."""
     from flagwrap.analysis.critical import RunCache
     from flagwrap.analysis.waiting_time import waiting_time_sweep

@@ -41,13 +41,35 @@ def _gravity(outdir):
     return gravity_figure(outdir)
 
 
+def _show_run(label, r):
+    print(f"  {label:<28} M = {r.machin:9.2f}  {'BUCKLED' if r.buckled else 'stable ':7s}  "
+          f"{'reused' if r.reused else 'simulated'}", flush=True)
+
+
 def _paper(name):
     def build(outdir):
         from flagwrap.plotting import figures
 
-        return getattr(figures, name)(outdir)
+        return getattr(figures, name)(outdir, on_run=_show_run)
 
     return build
+
+
+#: what each figure computes (printed before it starts, and by --dry-run)
+PLANS = {
+    "fig3": "the quasi-static stretching of the Fig. 3 helix (seconds)",
+    "fig4": "the critical search of the Fig. 4(a) helix (cache out/critical), then 4 full runs at "
+            "0.85 and 2.05 x its omega_c, HI on and off (cache out/paper)",
+    "fig6": "the critical search of the Fig. 4(a) helix (cache out/critical), then 5 runs at "
+            "eps = 0.1 .. 2 above it (cache out/waiting)",
+    "figS7": "the same runs as fig6 (cache out/critical, out/waiting)",
+    "fig5": "nothing: drawn from the sweep rows in out/sweeps/fig5 (or fig5-quick + fig5-boundary)",
+    "gravity": "the static equilibria of the Fig. 4(a) helix (~40 s); the rest from the sweep rows "
+               "in out/sweeps/gravity-fig4a and gravity-fig5",
+}
+#: cache folders a figure reads its runs from
+CACHES = {"fig4": ("out/critical", "out/paper"), "fig6": ("out/critical", "out/waiting"),
+          "figS7": ("out/critical", "out/waiting")}
 
 
 # figure name -> callable(outdir) -> list of written paths (import heavy modules inside it)
@@ -67,12 +89,29 @@ FIGURES = {
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("name", choices=sorted(FIGURES), metavar="NAME", help=f"figure: {', '.join(sorted(FIGURES))}")
     p.add_argument("-o", "--outdir", default="out/figures", help="output folder (default out/figures)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="say what the figure would compute and which cached runs exist; run nothing")
 
 
 def run(args: argparse.Namespace) -> int:
     from flagwrap.io.outputs import check_output_dir
 
+    from pathlib import Path
+
     check_output_dir(args.outdir, "figure folder (-o)")
-    for path in FIGURES[args.name](args.outdir):
+    cached = ", ".join(f"{d}: {len(list(Path(d).glob('*.nc')))} cached runs" for d in CACHES.get(args.name, ()))
+    print(f"figure {args.name}: {PLANS[args.name]}" + (f" [{cached}]" if cached else "")
+          + ("; a run not cached takes ~40 s" if args.name in CACHES else ""), flush=True)
+    if args.dry_run:
+        return 0
+    try:
+        paths = FIGURES[args.name](args.outdir)
+    except KeyboardInterrupt:
+        import sys
+
+        print(f"flagwrap figure: interrupted; the runs finished so far are cached and are reused "
+              f"by the next `flagwrap figure {args.name}`", file=sys.stderr)
+        return 130
+    for path in paths:
         print(path)
     return 0

@@ -318,28 +318,33 @@ def _n_fittable(times) -> int:
     return int((np.isfinite(t) & (t > 0)).sum())
 
 
-def _fig6_data(root=".", on_run=None):
+def _fig6_data(root=None, on_run=None):
     """Critical search of :data:`flagwrap.analysis.paper_runs.FIG6_GEOMETRY`, the sweep, the fit."""
     from flagwrap.analysis import paper_runs
     from flagwrap.analysis.waiting_time import PowerLawFit
 
-    mc = paper_runs.critical(paper_runs.FIG6_GEOMETRY, root=root).machin_c
-    rows = paper_runs.fig6_runs(mc, on_run=on_run, root=root)
+    report = on_run or (lambda *a: None)
+    mc = paper_runs.critical(paper_runs.FIG6_GEOMETRY, root=root,
+                             on_run=lambda r: report("critical search", r)).machin_c
+    rows = paper_runs.fig6_runs(mc, on_run=lambda eps, r: report(f"eps = {eps:g}", r), root=root)
     eps = np.array([r["eps"] for r in rows])
     tc = np.array([r["waiting_time"] for r in rows])
     fit = PowerLawFit().compute(eps, tc) if _n_fittable(tc) >= 3 else None
     return mc, rows, eps, tc, fit
 
 
-def fig4(outdir: str | Path = "out/figures", root=".") -> list[Path]:
+def fig4(outdir: str | Path = "out/figures", root=None, on_run=None) -> list[Path]:
     """Fig. 4(c)-(e) from the cached runs of :func:`flagwrap.analysis.paper_runs.fig4_runs`
-    (the critical search of the Fig. 4(a) helix and the four runs are made if missing)."""
+    (the critical search of the Fig. 4(a) helix and the four runs are made if missing).
+    ``on_run(label, CriticalRun)`` is called for every run as it is known."""
     from flagwrap.analysis import paper_runs
     from flagwrap.io.runfile import read_run
 
-    search = paper_runs.critical("fig4a", root=root)
+    report = on_run or (lambda *a: None)
+    search = paper_runs.critical("fig4a", root=root, on_run=lambda r: report("critical search", r))
     mc = search.machin_c
-    files = paper_runs.fig4_runs(mc, root=root)
+    files = paper_runs.fig4_runs(mc, root=root, on_run=lambda k, r: report(
+        f"omega/omega_c = {k[0]:g}, HI {'on' if k[1] else 'off'}", r))
     runs = {k: read_run(p) for k, p in files.items()}
     fig = plot_fig4(runs)
     paths = _save(fig, Path(outdir), "fig4")
@@ -371,11 +376,11 @@ def _write_json(obj, path: Path) -> Path:
     return path
 
 
-def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
+def fig6(outdir: str | Path = "out/figures", root=None, on_run=None) -> list[Path]:
     """Fig. 6 (waiting time against eps, 0.5/eps, fit, log-log inset) from cached sweep runs."""
     from flagwrap.analysis.waiting_time import PowerLawFit
 
-    mc, rows, eps, tc, fit = _fig6_data(root)
+    mc, rows, eps, tc, fit = _fig6_data(root, on_run)
     from flagwrap.analysis.waiting_time import departure_time
     from flagwrap.io.runfile import read_run
 
@@ -406,11 +411,11 @@ def fig6(outdir: str | Path = "out/figures", root=".") -> list[Path]:
     return paths
 
 
-def figS7(outdir: str | Path = "out/figures", root=".") -> list[Path]:
+def figS7(outdir: str | Path = "out/figures", root=None, on_run=None) -> list[Path]:
     """SI Fig. S7(a) (free-end height for several omega, t_c marked) from the Fig. 6 sweep runs."""
     from flagwrap.io.runfile import read_run
 
-    mc, rows, _, _, _ = _fig6_data(root)
+    mc, rows, _, _, _ = _fig6_data(root, on_run)
     runs = [(r["omega_ratio"], read_run(r["path"]), r["waiting_time"]) for r in rows]
     fig = plot_figS7(runs, title=_geometry_title(root, mc))
     paths = _save(fig, Path(outdir), "figS7")
