@@ -8,3 +8,20 @@ Data flows one way: parameters -> initial state -> stepper(forces, mobility) -> 
 """
 
 __version__ = "0.1.0"
+
+#: the Python API (flagwrap.api), one function per command, imported on first use
+_API = ("load", "run", "RunResult", "analyze", "critical", "CriticalResult", "sweep", "figure",
+        "bacteria")
+__all__ = ["__version__", *_API]
+
+
+def __getattr__(name):
+    if name in ("sweep", "bacteria"):  # packages whose modules are callable (api.CallableModule)
+        import importlib
+
+        return importlib.import_module(f"flagwrap.{name}")
+    if name in _API:
+        from flagwrap import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'flagwrap' has no attribute {name!r}")

@@ -10,3 +10,15 @@ from flagwrap.bacteria.species import (
 )
 
 __all__ = ["Provenance", "Species", "default_species", "format_table", "load_species_file", "parse_species"]
+
+
+def _callable():
+    # ``flagwrap.bacteria(...)`` is the Python API's :func:`flagwrap.api.bacteria` (see CallableModule)
+    import sys
+
+    from flagwrap.api import CallableModule
+
+    sys.modules[__name__].__class__ = CallableModule
+
+
+_callable()

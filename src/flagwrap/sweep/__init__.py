@@ -12,3 +12,15 @@ from flagwrap.sweep.spec import Case, SweepSpec, load_spec, resolve_geometry, sp
 from flagwrap.sweep.store import SweepStore
 
 __all__ = ["Case", "SweepSpec", "SweepStore", "load_spec", "resolve_geometry", "spec_from_dict"]
+
+
+def _callable():
+    # ``flagwrap.sweep(...)`` is the Python API's :func:`flagwrap.api.sweep` (see CallableModule)
+    import sys
+
+    from flagwrap.api import CallableModule
+
+    sys.modules[__name__].__class__ = CallableModule
+
+
+_callable()
