@@ -4,12 +4,15 @@
     python studies/gravity.py static             # Fig. 4(a) helix, motor at rest: rise vs G
     python studies/gravity.py static --check     # ... and the time loop's end state at two G
     python studies/gravity.py waiting --mismatch -0.02 --machin-c 383 [--eps 0.1 0.25 0.5 1]
+    python studies/gravity.py movies [--mismatch 0 -0.01 -0.02 -0.03]
 
 ``greenhill`` and ``static`` take seconds (static equilibria by Newton,
 flagwrap.analysis.static_buckling). ``waiting`` runs the Fig. 4(a) helix at the given density
 mismatch at M = (1 + eps) M_c (the test-run protocol of ``flagwrap critical``: 5 CCW turns,
 then CW) into out/gravity-waiting/ (cached: re-running reuses the runs) and prints t_c/T
-against the paper's 0.5/eps.
+against the paper's 0.5/eps. ``movies`` runs the SI movie configs (examples/movie*.toml, their
+own frequencies and 10 CCW + 10 CW protocol, in full) at each density mismatch into
+out/gravity-movies/ (cached) and prints this model's class beside the paper's.
 """
 
 from __future__ import annotations
@@ -97,6 +100,39 @@ def waiting(mismatch, machin_c, eps_values):
               f"{0.5 / r['eps']:>8.2f} {r.get('state')!s:>9}")
 
 
+#: SI movie configs and the paper's outcome at the movie's frequency (SI "Supplemental Movies")
+MOVIES = (("movie2", "stable", "twirling, 0.86 omega_c"), ("movie3", "wrapping", "1.97 omega_c"),
+          ("movie5", "folding", "1.72 omega_c"), ("movie6", "folding", "normal form, 1.29 omega_c"),
+          ("movie7", "buckled", "critical, 1.04 omega_c"))
+
+
+def movies(mismatches):
+    import functools
+    from pathlib import Path
+
+    from flagwrap.analysis.critical import RunCache, simulate_and_analyse
+    from flagwrap.io.config import config_from_dict, load_config
+
+    root = Path(__file__).resolve().parents[1]
+    cache = RunCache("out/gravity-movies", runner=functools.partial(simulate_and_analyse, stop_after=None),
+                     key_extra="full protocol")
+    print(f"{'movie':<7} {'paper':<9} {'mismatch':>8} {'G':>7} {'M':>7} {'model class':<11} "
+          f"{'buckled':<7} {'t_c/T':>6}  paper's note")
+    for name, paper, note in MOVIES:
+        base = load_config(root / "examples" / f"{name}.toml")
+        for dm in mismatches:
+            d = base.to_dict()
+            d["filament"].pop("density", None)
+            if dm != 0:
+                d["filament"]["density_mismatch"] = dm
+            cfg = config_from_dict(d)
+            r = cache.run(cfg)
+            t = r.waiting_time
+            print(f"{name:<7} {paper:<9} {dm:>+8.3g} {cfg.gravity_number:>7.3g} {cfg.machin:>7.4g} "
+                  f"{r.state:<11} {str(r.buckled):<7} {'-' if t is None else f'{t:.2f}':>6}  {note}",
+                  flush=True)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="what", required=True)
@@ -107,11 +143,15 @@ def main(argv=None):
     w.add_argument("--mismatch", type=float, required=True)
     w.add_argument("--machin-c", type=float, required=True)
     w.add_argument("--eps", type=float, nargs="+", default=[0.1, 0.25, 0.5, 1.0])
+    m = sub.add_parser("movies")
+    m.add_argument("--mismatch", type=float, nargs="+", default=[0.0, -0.01, -0.02, -0.03])
     a = p.parse_args(argv)
     if a.what == "greenhill":
         greenhill()
     elif a.what == "static":
         static(a.check)
+    elif a.what == "movies":
+        movies(a.mismatch)
     else:
         waiting(a.mismatch, a.machin_c, a.eps)
 

@@ -22,10 +22,14 @@ from conftest import tiny_toml
 
 @pytest.fixture(scope="module")
 def world(tmp_path_factory):
-    """A folder with a tiny config, a completed run file, a corrupt copy, a file and a folder."""
+    return make_world(tmp_path_factory.mktemp("hostile"))
+
+
+def make_world(d: Path) -> Path:
+    """A folder with a tiny config, a completed run file, a corrupt copy, a file and a folder
+    (also used by studies/hostile.py)."""
     from flagwrap.cli.main import main
 
-    d = tmp_path_factory.mktemp("hostile")
     (d / "tiny.toml").write_text(tiny_toml(ccw=1.0, cw=1.0))
     assert main(["run", str(d / "tiny.toml"), "-o", str(d / "good.nc"), "--quiet"]) == 0
     (d / "afile").write_text("not a folder\n")

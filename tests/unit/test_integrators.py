@@ -326,3 +326,23 @@ def test_jax_backend_runs_the_motion_of_the_direct_sum():
     assert direct.ok and jx.ok
     assert abs(jx.n_steps - direct.n_steps) <= 0.1 * direct.n_steps
     assert np.abs(np.asarray(direct.x)[-1] - np.asarray(jx.x)[-1]).max() < 5e-5
+
+
+@pytest.mark.parametrize("integrator", [ROS34PW2(tol=1e-5), ROS2(tol=1e-5), ExplicitEuler()])
+def test_a_degenerate_stage_is_a_rejected_step(integrator, monkeypatch):
+    # numba raises ZeroDivisionError where a stage puts two beads on top of each other (found
+    # in a Fig. 5 sweep at M ~ 1e5: the exception killed the whole boundary search); it must be
+    # a rejection, so the controller shrinks the step
+    s, y, info = _rest_state(11)
+    real = s.forces
+
+    def degenerate(yy, base):
+        if not np.array_equal(yy, y):
+            raise ZeroDivisionError("division by zero")
+        return real(yy, base)
+
+    monkeypatch.setattr(s, "forces", degenerate)
+    res = integrator.step(s, y, info.frames, info, 1e-2, 1.0)
+    assert not res.accepted and "bond of zero length" in res.reason
+    if integrator.adaptive:
+        assert res.h_next < 1e-2

@@ -64,7 +64,11 @@ class AdaptiveMixin:
         h_next = h * min(self.grow, max(self.shrink, fac))
         if err > 1.0:
             return StepResult(False, None, None, h_next, err, "error above tolerance")
-        return StepResult(True, y_new, system.forces(y_new, base), h_next, err)
+        try:
+            info = system.forces(y_new, base)
+        except ZeroDivisionError:  # numba raises where numpy would give inf: a bond of zero length
+            return self.reject(h, "degenerate state (a bond of zero length)")
+        return StepResult(True, y_new, info, h_next, err)
 
 
 def scaled_error(system, err: np.ndarray, tol: float) -> float:

@@ -23,5 +23,8 @@ class ExplicitEuler(Integrator):
         y_new = y + h * f
         if not np.all(np.isfinite(y_new)):
             return StepResult(False, None, None, h, np.nan, "non-finite state")
-        info_new = system.forces(y_new, base)
+        try:
+            info_new = system.forces(y_new, base)
+        except ZeroDivisionError:  # numba raises where numpy would give inf: a bond of zero length
+            return StepResult(False, None, None, h, np.nan, "degenerate state (a bond of zero length)")
         return StepResult(True, y_new, info_new, h, np.nan)

@@ -70,7 +70,10 @@ class ROS34PW2(AdaptiveMixin, Integrator):
                 Yi = y + A_T[i, :i] @ U[:i]
                 if not np.all(np.isfinite(Yi)):
                     return self.reject(h, "non-finite stage")
-                f, _ = system.rhs(Yi, base, omega)
+                try:
+                    f, _ = system.rhs(Yi, base, omega)
+                except ZeroDivisionError:  # a stage so far off that a bond has zero length
+                    return self.reject(h, "degenerate stage (a bond of zero length)")
             rhs = f + (C_T[i, :i] @ U[:i]) / h if i else f
             try:
                 U[i] = W.solve((GAMMA * h) * rhs)

@@ -50,7 +50,10 @@ class ROS2(AdaptiveMixin, Integrator):
         y1 = y + h * k1
         if not np.all(np.isfinite(y1)):
             return self.reject(h, "non-finite stage")
-        f1, _ = system.rhs(y1, base, omega)
+        try:
+            f1, _ = system.rhs(y1, base, omega)
+        except ZeroDivisionError:  # a stage so far off that a bond has zero length
+            return self.reject(h, "degenerate stage (a bond of zero length)")
         try:
             k2 = W.solve(f1 - 2.0 * k1)
         except SingularW as exc:
