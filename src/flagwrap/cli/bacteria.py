@@ -99,7 +99,7 @@ def format_model_boundary(species, fit: dict, source) -> str:
     c3 = fit["prefactor_beta3"]
     c, beta = fit.get("prefactor"), fit.get("exponent")
     free = isinstance(c, (int, float)) and isinstance(beta, (int, float)) and math.isfinite(c) and math.isfinite(beta)
-    head = f"{'species':<34} {'M':>8} {'M/M_c paper':>11} {'M/M_c model':>11}" + (f" {'(free beta)':>11}" if free else "") + "  side (model)"
+    head = f"{'species':<39} {'M':>8} {'M/M_c paper':>11} {'M/M_c model':>11}" + (f" {'(free beta)':>11}" if free else "") + "  side (model)"
     lines = [f"This model's density-matched boundary ({source}): M_c = {c3:.3g} (R/L)^-3"
              + (f"; free fit M_c = {c:.3g} (R/L)^-{beta:.2f}" if free else "")
              + ". Measured at a/L = 1/267 (the paper's helices), extrapolated to the bacteria's own "
@@ -107,8 +107,8 @@ def format_model_boundary(species, fit: dict, source) -> str:
     for s in species:
         rl = s.radius_um / s.length_um
         r3 = s.machin / (c3 * rl ** -3)
-        label = f"{s.name[:25]} ({s.form})"
-        row = f"{label:<34} {s.machin:>8.4g} {s.instability_ratio(0.06):>11.3g} {r3:>11.3g}"
+        label = f"{s.name[:30]} ({s.form})"
+        row = f"{label:<39} {s.machin:>8.4g} {s.instability_ratio(0.06):>11.3g} {r3:>11.3g}"
         if free:
             row += f" {s.machin / (c * rl ** -beta):>11.3g}"
         lines.append(row + f"  {'unstable' if r3 > 1 else 'stable'}")
