@@ -4,7 +4,7 @@
     python studies/gravity.py static             # Fig. 4(a) helix, motor at rest: rise vs G
     python studies/gravity.py static --check     # ... and the time loop's end state at two G
     python studies/gravity.py waiting --mismatch -0.02 --machin-c 383 [--eps 0.1 0.25 0.5 1]
-    python studies/gravity.py movies [--mismatch 0 -0.01 -0.02 -0.03]
+    python studies/gravity.py movies [--mismatch 0 -0.01 -0.02 -0.03] [--only movie6 movie7]
 
 ``greenhill`` and ``static`` take seconds (static equilibria by Newton,
 flagwrap.analysis.static_buckling). ``waiting`` runs the Fig. 4(a) helix at the given density
@@ -106,7 +106,7 @@ MOVIES = (("movie2", "stable", "twirling, 0.86 omega_c"), ("movie3", "wrapping",
           ("movie7", "buckled", "critical, 1.04 omega_c"))
 
 
-def movies(mismatches):
+def movies(mismatches, only=None):
     import functools
     from pathlib import Path
 
@@ -119,6 +119,8 @@ def movies(mismatches):
     print(f"{'movie':<7} {'paper':<9} {'mismatch':>8} {'G':>7} {'M':>7} {'model class':<11} "
           f"{'buckled':<7} {'t_c/T':>6}  paper's note")
     for name, paper, note in MOVIES:
+        if only and name not in only:
+            continue
         base = load_config(root / "examples" / f"{name}.toml")
         for dm in mismatches:
             d = base.to_dict()
@@ -145,13 +147,14 @@ def main(argv=None):
     w.add_argument("--eps", type=float, nargs="+", default=[0.1, 0.25, 0.5, 1.0])
     m = sub.add_parser("movies")
     m.add_argument("--mismatch", type=float, nargs="+", default=[0.0, -0.01, -0.02, -0.03])
+    m.add_argument("--only", nargs="+", help="movie names (default: all)")
     a = p.parse_args(argv)
     if a.what == "greenhill":
         greenhill()
     elif a.what == "static":
         static(a.check)
     elif a.what == "movies":
-        movies(a.mismatch)
+        movies(a.mismatch, a.only)
     else:
         waiting(a.mismatch, a.machin_c, a.eps)
 
