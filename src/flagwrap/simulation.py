@@ -239,7 +239,9 @@ class Simulation:
         if progress:
             from tqdm.auto import tqdm
 
-            bar = tqdm(total=round((t_end - t0) / TWO_PI, 3), unit="turn", desc=self.config.name,
+            # the whole run's turns, a resumed run starting where it stopped
+            bar = tqdm(total=round(t_end / TWO_PI, 3), initial=round(t0 / TWO_PI, 3), unit="turn",
+                       desc=self.config.name,
                        bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} turns [{elapsed}<{remaining}]")
         start = _time.perf_counter()
         last_ck = start
@@ -288,7 +290,12 @@ class Simulation:
                     # do not let a step clipped to an output time shrink the controller's step
                     h = res.h_next if h_try >= h * 0.999 else max(h, res.h_next)
                 if bar is not None:
-                    bar.update(round((t_new - t) / TWO_PI, 6))
+                    # set, not summed: summed rounded increments overshoot the total (tqdm's
+                    # "clamping frac" warning and a negative remaining time at the end)
+                    done = min(bar.total, round(t_new / TWO_PI, 3))
+                    if done > bar.n:
+                        bar.n = done
+                        bar.update(0)
                 t = t_new
                 if t >= next_save - eps:
                     self._record(traj, t, y, info, omega)

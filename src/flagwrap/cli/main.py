@@ -47,7 +47,9 @@ def build_parser() -> argparse.ArgumentParser:
     for name in COMMANDS:
         mod = _load(name)
         doc = (mod.__doc__ or "").strip().splitlines()
-        p = sub.add_parser(name, help=doc[0] if doc else "", description=(mod.__doc__ or ""))
+        # the module docstrings are laid out by hand (example lines, tables): keep their lines
+        p = sub.add_parser(name, help=doc[0] if doc else "", description=(mod.__doc__ or ""),
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
         mod.add_arguments(p)
         p.set_defaults(_module=mod)
     return parser

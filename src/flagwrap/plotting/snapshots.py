@@ -110,8 +110,15 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     if title is None:
         hi = "with HI" if ds.attrs.get("hydrodynamics", 1) else "without HI"
         title = f"{ds.attrs.get('title', 'flagwrap run')}: M = {float(ds.attrs['machin']):.4g}, {hi}"
-    fig.suptitle(title, fontsize=8)
-    fig.tight_layout(rect=(0, 0, 1, 0.96), w_pad=0.2, h_pad=0.3)
+    # wrapped to the figure's width (~13 characters per inch at 8 pt): a one-column strip is
+    # narrower than its title
+    import textwrap
+
+    width_in = fig.get_size_inches()[0]
+    lines = textwrap.wrap(title, max(16, int(13 * width_in))) or [""]
+    fig.suptitle("\n".join(lines), fontsize=8)
+    top = 1 - (0.12 * len(lines) + 0.05) / fig.get_size_inches()[1]
+    fig.tight_layout(rect=(0, 0, 1, min(0.96, top)), w_pad=0.2, h_pad=0.3)
     return fig
 
 

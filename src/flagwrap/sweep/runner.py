@@ -89,7 +89,7 @@ def run_case(case: Case, root) -> dict:
         row.update(status="failed", state="failed", buckled=None,
                    error=f"{type(exc).__name__}: {exc}")
     row["wall_time_s"] = time.perf_counter() - t0
-    row["finished_at"] = time.time()
+    row["finished_at"] = _now_iso()
     row["host"] = socket.gethostname()
     row["run_file"] = str(path) if path.is_file() else None
     store.write_row(row)
@@ -246,3 +246,10 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
 
 def fmt_float(v, f=".3g"):
     return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, f)
+
+
+def _now_iso() -> str:
+    """The current time as ISO 8601 in UTC with seconds (rows and tables: readable, sortable)."""
+    import datetime
+
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
