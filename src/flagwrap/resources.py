@@ -117,8 +117,52 @@ def _gb(x: float) -> str:
     return f"{x / 2**30:.3g} GiB"
 
 
+#: cost of one time step of the direct RPY sum per bead pair [s]: ROS34PW2 + GCR at N = 4000
+#: took 0.55 s per step on one core of this machine class (docs/numerics.md, benchmarks/gpu.py)
+DIRECT_STEP_SECONDS_PER_PAIR = 0.55 / 4000**2
+#: a single step longer than this is refused unless FLAGWRAP_MAX_STEP_SECONDS says otherwise
+MAX_STEP_SECONDS = 60.0
+
+
+def step_seconds(config) -> float:
+    """Estimated wall time of one time step [s]: the O(N^2) direct RPY products dominate with
+    long-range hydrodynamics on the direct backend; 0 where the estimate does not apply
+    (HI off, FMM or GPU backends, which scale ~N)."""
+    num = config.numerics
+    if not num.hydrodynamics or num.mobility_backend not in ("direct", "auto"):
+        return 0.0
+    return DIRECT_STEP_SECONDS_PER_PAIR * float(config.filament.n_beads) ** 2
+
+
+def check_time(config) -> float:
+    """Raise :class:`UserInputError` if one step of ``config`` would take longer than the
+    limit (``FLAGWRAP_MAX_STEP_SECONDS`` or :data:`MAX_STEP_SECONDS`); returns the estimate."""
+    sec = step_seconds(config)
+    env = os.environ.get("FLAGWRAP_MAX_STEP_SECONDS")
+    try:
+        limit = float(env) if env else MAX_STEP_SECONDS
+    except ValueError:
+        raise UserInputError(f"FLAGWRAP_MAX_STEP_SECONDS must be a number of seconds, got {env!r}") from None
+    if sec <= limit:
+        return sec
+    if config.numerics.mobility_backend == "auto":
+        from flagwrap.hydrodynamics.mobility import GPU_AUTO_MIN_BEADS, jax_gpu_available
+
+        if config.filament.n_beads >= GPU_AUTO_MIN_BEADS and jax_gpu_available():
+            return 0.0  # "auto" takes the GPU
+    N = config.filament.n_beads
+    raise UserInputError(
+        f"filament.n_beads={N} with hydrodynamics on the direct RPY sum: one time step would take "
+        f"about {sec:.3g} s ({N}^2 bead pairs; 0.55 s at 4000 beads on one core), a motor turn "
+        f"~1000 steps; the limit is {limit:g} s per step ({'FLAGWRAP_MAX_STEP_SECONDS' if env else 'default'}). "
+        "Use numerics.mobility_backend = \"fmm\" (pip install fmm3dpy) or \"jax\" on a GPU, reduce "
+        "n_beads, or raise FLAGWRAP_MAX_STEP_SECONDS")
+
+
 def check_memory(config, limit: float | None = None) -> Estimate:
-    """Raise :class:`UserInputError` if ``config`` would need more memory than ``limit``."""
+    """Raise :class:`UserInputError` if ``config`` would need more memory than ``limit``
+    (and, first, if one step would take longer than :func:`check_time` allows)."""
+    check_time(config)
     est = estimate(config)
     why = "given limit"
     if limit is None:

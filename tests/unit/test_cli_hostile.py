@@ -49,6 +49,7 @@ def make_world(d: Path) -> Path:
     b[m:m + 4096] = bytes(x ^ 0xFF for x in b[m:m + 4096])
     (d / "middle.nc").write_bytes(bytes(b))
     (d / "notnc.nc").write_text("hello\n")
+    (d / "n200k.toml").write_text(tiny_toml(n_beads=200000))
     (d / "rod.csv").write_text("L,F\n0.05,0.02\n0.10,0.05\n0.15,0.09\n0.20,0.14\n")  # F > 0: wrong sign
     bad = tiny_toml().replace("length = 0.4", "length = 1e30").replace("helix_radius = 0.03", "helix_radius = 1e28")
     (d / "huge.toml").write_text(bad)
@@ -92,6 +93,7 @@ HOSTILE = [
     (["movie", "{d}/good.nc", "--size", "100000x100000", "-o", "{d}/m.mp4", "--quiet"], "nearest allowed: 7680x4320"),
     (["sweep", "{d}/big.toml", "--dry-run", "--out", "{d}/sw"], "1000 x 1000 x 1 = 1000000 cases"),
     (["movie", "{d}/good.nc", "--fps", "1e9", "-o", "{d}/m.mp4", "--quiet"], "--fps"),
+    (["run", "{d}/n200k.toml", "-o", "{d}/new.nc", "--quiet"], "one time step would take"),
     # 4. absurd physics and values
     (["run", "{d}/huge.toml", "-o", "{d}/new.nc", "--quiet"], "bond length"),
     (["run", "{d}/body.toml", "-o", "{d}/new.nc", "--quiet"], "body.radius_ratio"),

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 
@@ -133,11 +134,21 @@ def min_nonlocal_distance(fil, clamp=None) -> float:
         idx = np.linspace(0, N - 1, 4000).astype(int)
     else:
         idx = np.arange(N)
-    best = np.inf
-    for i in idx:
-        j0 = i + skip + 1
-        if j0 >= N:
-            continue
-        d = np.linalg.norm(x[j0:] - x[i], axis=1).min()
-        best = min(best, d)
-    return float(best)
+    return float(_min_distance_beyond(np.ascontiguousarray(x), idx.astype(np.int64), skip))
+
+
+@numba.njit(cache=True)
+def _min_distance_beyond(x, rows, skip):
+    """min |x_j - x_i| over i in ``rows`` and j > i + skip (no temporaries: at N = 2e5 the
+    numpy version allocated ~20 GB over its 4000 rows and took 12 s)."""
+    best2 = np.inf
+    n = x.shape[0]
+    for i in rows:
+        for j in range(i + skip + 1, n):
+            dx = x[j, 0] - x[i, 0]
+            dy = x[j, 1] - x[i, 1]
+            dz = x[j, 2] - x[i, 2]
+            d2 = dx * dx + dy * dy + dz * dz
+            if d2 < best2:
+                best2 = d2
+    return np.sqrt(best2)
