@@ -406,3 +406,19 @@ def test_an_interrupted_sweep_of_a_changed_spec_shows_its_own_rows(tmp_path, fak
     shown = list(store.iter_rows())
     assert len(list(store.iter_rows(everything=True))) == 4
     assert [r["key"] for r in shown] == [calls[0].key]
+
+
+def test_shipped_sweeps_load_by_name_from_any_folder(tmp_path, monkeypatch):
+    # the sweep files are package data (flagwrap/data/sweeps; examples/sweeps links to them),
+    # so a wheel install without the repository runs `flagwrap sweep fig5-quick`
+    from flagwrap.errors import UserInputError
+    from flagwrap.sweep.spec import builtin_specs, load_spec
+
+    monkeypatch.chdir(tmp_path)
+    assert {"fig5", "fig5-quick", "fig5-boundary", "gravity-fig4a", "gravity-fig5"} <= set(builtin_specs())
+    assert load_spec("fig5-quick").name == "fig5-quick"
+    assert load_spec("gravity-fig4a.toml").mode == "boundary"
+    with pytest.raises(UserInputError, match="built-in sweeps: fig5"):
+        load_spec("fig5-nope")
+    with pytest.raises(UserInputError, match="not found"):
+        load_spec("some/dir/fig5-quick")

@@ -65,6 +65,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(args._module.run(args) or 0)
+    except BrokenPipeError:  # `flagwrap ... | head`: the reader left; no traceback
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except OutputWriteError as exc:  # the work is done and kept elsewhere: not an input error
         print(f"flagwrap {args.command}: error: {exc}", file=sys.stderr)
         return 1

@@ -433,15 +433,27 @@ def spec_from_dict(data: dict, name: str = "sweep") -> SweepSpec:
     return SweepSpec(name, mode, tuple(cases), run, base, boundary, runner)
 
 
+def builtin_specs() -> dict:
+    """The sweep files shipped with the package (``flagwrap/data/sweeps``, also
+    ``examples/sweeps`` in a checkout): name -> path."""
+    folder = Path(__file__).resolve().parents[1] / "data" / "sweeps"
+    return {p.stem: p for p in sorted(folder.glob("*.toml"))}
+
+
 def load_spec(path) -> SweepSpec:
-    """Read a sweep TOML file (:func:`spec_from_dict`); the default name is the file stem."""
+    """Read a sweep TOML file (:func:`spec_from_dict`); the default name is the file stem. A
+    bare name of a shipped sweep (``fig5-quick``, :func:`builtin_specs`) works from any folder."""
     try:
         import tomllib
     except ModuleNotFoundError:  # pragma: no cover
         import tomli as tomllib
     path = Path(path)
     if not path.is_file():
-        raise UserInputError(f"sweep file not found: {path}")
+        builtin = builtin_specs().get(str(path).removesuffix(".toml"))
+        if builtin is None or len(path.parts) > 1:
+            raise UserInputError(f"sweep file not found: {path} (built-in sweeps: "
+                                 f"{', '.join(sorted(builtin_specs()))})")
+        path = builtin
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
