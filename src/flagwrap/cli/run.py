@@ -133,6 +133,12 @@ def _simulate(args, cfg, out, ckpt, resume) -> int:
           f"G = {cfg.gravity_number:.4g}{_mismatch(cfg)}, "
           f"omega/omega_c (scaling) = {cfg.omega_ratio_scaling:.3g}, N = {cfg.filament.n_beads}, "
           f"HI {'on' if cfg.numerics.hydrodynamics else 'off'}", file=sys.stderr)
+    if cfg.reynolds > 0.1:
+        # the model is Stokes flow by construction; the dimensionless result holds for any fluid
+        # at this M, but not for this SI fluid at this speed
+        print(f"flagwrap run: note: Re = {cfg.reynolds:.3g} > 0.1: Stokes flow (the model) does not "
+              "describe this fluid at this speed; the result holds for the same M in a more viscous "
+              "fluid or at a smaller scale", file=sys.stderr)
     from flagwrap.simulation import RunInterrupted
 
     try:

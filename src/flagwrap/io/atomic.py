@@ -123,3 +123,14 @@ def read_error(path, what: str, exc: BaseException) -> str:
         return (f"{path} is corrupt: it fails its checksum ({text}); the file is left as it "
                 f"is, re-create it")
     return f"{path} is not a readable {what} (truncated, damaged or not netCDF4/HDF5): {text}"
+
+
+def savefig_atomic(fig, path, **kwargs) -> Path:
+    """``fig.savefig`` into a temporary file beside ``path`` (same suffix, so matplotlib picks
+    the format) and renamed in: an existing figure is replaced only by a complete one."""
+    path = Path(path)
+
+    def write(tmp):
+        fig.savefig(tmp, format=path.suffix.lstrip(".").lower() or None, **kwargs)
+
+    return atomic_write(path, write)

@@ -296,13 +296,20 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
         name = f"filament_{i:0{width}d}.vtp"
         pdata = frame_point_data(X[i], M1[i], forces, rest)
         cdata = {"turns": np.array([turns[i]]), "time": np.array([secs[i]])}
-        (d / name).write_text(polydata_xml(X[i], lines=line, point_data=pdata, cell_data=cdata))
+        _write(d / name, polydata_xml(X[i], lines=line, point_data=pdata, cell_data=cdata))
         entries.append((float(tvals[i]), 0, name))
     scene = scene_of(ds)
     if scene.has_body:
         v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around)
-        (d / "body.vtp").write_text(polydata_xml(v, polys=f))
+        _write(d / "body.vtp", polydata_xml(v, polys=f))
         entries += [(float(tvals[i]), 1, "body.vtp") for i in idx]
     pvd = d / "run.pvd"
-    pvd.write_text(pvd_xml(entries))
+    _write(pvd, pvd_xml(entries))  # last: a complete .pvd names only complete frames
     return pvd
+
+
+def _write(path, text: str) -> None:
+    """Write one VTK file atomically (temporary file beside it, renamed in)."""
+    from flagwrap.io.atomic import atomic_write
+
+    atomic_write(path, lambda tmp: tmp.write_text(text))

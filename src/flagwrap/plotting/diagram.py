@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from flagwrap.errors import UserInputError
+from flagwrap.io.atomic import savefig_atomic
 
 PAPER_PREFACTOR = 0.06
 #: sweep folders read by ``flagwrap figure fig5``: the first group that has rows
@@ -213,8 +214,8 @@ def fig5(outdir="out/figures", sweep_dirs=None) -> list:
                  fontsize=9)
     fig.tight_layout()
     paths = [outdir / "fig5.png", outdir / "fig5.pdf"]
-    fig.savefig(paths[0], dpi=150)
-    fig.savefig(paths[1])
+    savefig_atomic(fig, paths[0], dpi=150)
+    savefig_atomic(fig, paths[1])
     plt.close(fig)
     counts = {}
     for r in rows:

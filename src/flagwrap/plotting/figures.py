@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from flagwrap.io.atomic import savefig_atomic
+
 __all__ = ["fig3", "fig4", "fig6", "figS7", "plot_fig4", "plot_fig6", "plot_figS7"]
 
 #: SI stretching-test helix (SI "Uniaxial stretching test of a helix"), lengths [m], E [Pa].
@@ -19,8 +21,8 @@ FIG3_HELIX = dict(radius=15e-3, pitch=34e-3, length=305e-3, youngs_modulus=1.2 *
 def _save(fig, outdir: Path, name: str) -> list[Path]:
     outdir.mkdir(parents=True, exist_ok=True)
     paths = [outdir / f"{name}.png", outdir / f"{name}.pdf"]
-    fig.savefig(paths[0], dpi=150)
-    fig.savefig(paths[1])
+    savefig_atomic(fig, paths[0], dpi=150)
+    savefig_atomic(fig, paths[1])
     return paths
 
 
@@ -126,7 +128,7 @@ def save_png_pdf(fig, stem):
     out = []
     for ext in ("png", "pdf"):
         p = stem.with_suffix(f".{ext}")
-        fig.savefig(p, dpi=150)
+        savefig_atomic(fig, p, dpi=150)
         out.append(p)
     return out
 
@@ -372,7 +374,10 @@ def _write_json(obj, path: Path) -> Path:
         return v
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(clean(obj), indent=1, sort_keys=True))
+    from flagwrap.io.atomic import atomic_write
+
+    text = json.dumps(clean(obj), indent=1, sort_keys=True)
+    atomic_write(path, lambda tmp: tmp.write_text(text))
     return path
 
 

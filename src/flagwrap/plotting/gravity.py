@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from flagwrap.errors import UserInputError
+from flagwrap.io.atomic import savefig_atomic
 
 PAPER_MACHIN_C_FIG4A = 283.0 / 2.05  # SI Movie 4: M = 283 is omega/omega_c = 2.05
 FIG4A_SWEEP = "out/sweeps/gravity-fig4a"
@@ -149,8 +150,8 @@ def gravity_figure(outdir="out/figures", fig4a_sweep=FIG4A_SWEEP, fig5_sweep=FIG
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     paths = [outdir / "gravity.png", outdir / "gravity.pdf"]
-    fig.savefig(paths[0], dpi=150)
-    fig.savefig(paths[1])
+    savefig_atomic(fig, paths[0], dpi=150)
+    savefig_atomic(fig, paths[1])
     plt.close(fig)
     info = {"fig4a": table, "paper_machin_c": PAPER_MACHIN_C_FIG4A,
             "static": {"G": branch.G.tolist(), "tip_height": branch.tip_height.tolist(),

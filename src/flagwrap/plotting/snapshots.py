@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from flagwrap.errors import UserInputError
+from flagwrap.io.atomic import savefig_atomic
 
 
 def cw_phase(ds):
@@ -79,8 +80,14 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from flagwrap.plotting.render import (CAMERAS, Renderer, nice_scale_bar, scene_of,
-                                          style_view, view_limits)
+    from flagwrap.plotting.render import (
+        CAMERAS,
+        Renderer,
+        nice_scale_bar,
+        scene_of,
+        style_view,
+        view_limits,
+    )
 
     times = default_times(ds, n) if times is None else np.atleast_1d(np.asarray(times, float))
     idx = frame_indices(ds, times)
@@ -136,7 +143,7 @@ def write_snapshots(ds, path, formats=("png", "pdf"), dpi: int = 200, **kwargs) 
     try:
         for fmt in formats:
             p = path.with_suffix("." + fmt.lstrip("."))
-            fig.savefig(p, dpi=dpi)
+            savefig_atomic(fig, p, dpi=dpi)
             out.append(p)
     finally:
         plt.close(fig)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from flagwrap.io.atomic import savefig_atomic
+
 
 def figure_suffixes() -> set:
     """File suffixes matplotlib can save (``.png``, ``.pdf``, ``.svg``, ...)."""
@@ -38,7 +40,7 @@ def summary_figure(ds, path):
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=150)
+    savefig_atomic(fig, path, dpi=150)
     plt.close(fig)
     return path
 
