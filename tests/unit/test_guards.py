@@ -209,9 +209,12 @@ def test_ctrl_c_keeps_a_readable_partial_run_file(tmp_path):
     cfgp.write_text(tiny_toml(ccw=50, cw=50).replace("tol = 1e-3", "tol = 1e-7"))  # minutes of work
     out = tmp_path / "long.nc"
     ckpt = tmp_path / "long.ckpt.h5"
+    # SIGINT back to its default in the child: a test run started in the background (nohup,
+    # `cmd &`) inherits SIGINT ignored, and the run then rightly ignores Ctrl-C too
     proc = subprocess.Popen([sys.executable, "-m", "flagwrap.cli.main", "run", str(cfgp), "--quiet",
                              "-o", str(out), "--checkpoint", str(ckpt), "--checkpoint-every", "50"],
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     # wait until the time loop runs (a checkpoint exists), however long imports and a cold
     # numba cache take, then let it save a few frames
     t0 = time.monotonic()
