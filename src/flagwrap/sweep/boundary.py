@@ -18,7 +18,7 @@ import socket
 import time
 from pathlib import Path
 
-from flagwrap.sweep.runner import RESULT_KEYS, _now_iso, case_row, resolve_runner, verdict
+from flagwrap.sweep.case import RESULT_KEYS, case_row, now_iso, resolve_runner, verdict
 from flagwrap.sweep.spec import Case
 from flagwrap.sweep.store import SweepStore
 
@@ -58,7 +58,7 @@ def run_geometry(case: Case, root, boundary: dict) -> dict:
             if k in res:
                 row[k] = res[k]
         status, error = verdict(res)
-        row.update(status=status, error=error, wall_time_s=time.perf_counter() - t1, finished_at=_now_iso(),
+        row.update(status=status, error=error, wall_time_s=time.perf_counter() - t1, finished_at=now_iso(),
                    host=socket.gethostname(), run_file=str(path) if Path(path).is_file() else None)
         store.write_row(row)
         return res

@@ -21,79 +21,18 @@ goes on. The row is written by the process that ran the case, atomically
 
 from __future__ import annotations
 
-import importlib
 import math
 import os
-import socket
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from flagwrap.sweep.spec import Case, SweepSpec
+# one case's run and row live in flagwrap.sweep.case, which the boundary search (imported by
+# this module) uses too: no import cycle; the names stay importable from here
+from flagwrap.sweep.case import (DEFAULT_RUNNER, RESULT_KEYS, case_row,  # noqa: F401
+                                 now_iso, resolve_runner, run_case, verdict)
+from flagwrap.sweep.spec import SweepSpec
 from flagwrap.sweep.store import SweepStore
-
-DEFAULT_RUNNER = "flagwrap.analysis.critical:simulate_and_analyse"
-
-#: analysis results copied into a row (analysis.buckling.BucklingAnalysis.summary)
-RESULT_KEYS = ("state", "buckled", "waiting_time_turns", "crossing_turns", "max_height",
-               "final_height", "winding_turns", "contact_fraction", "torque_peak_reduced",
-               "torque_final_reduced", "run_status", "message")
-
-
-def resolve_runner(name: str | None):
-    """Import a case function given as ``"module:function"`` (None: the default)."""
-    mod, _, fn = (name or DEFAULT_RUNNER).partition(":")
-    return getattr(importlib.import_module(mod), fn)
-
-
-def verdict(res: dict) -> tuple[str, str | None]:
-    """``(status, error)`` of a case function's result: ``"ok"`` only with a buckling verdict.
-
-    As in :class:`flagwrap.analysis.critical.RunCache`: a run that stopped early (a numerical
-    guard tripped) without buckling has no verdict — "stable" would be a guess.
-    """
-    buckled, run_status = res.get("buckled"), str(res.get("run_status", ""))
-    if buckled is None or res.get("state") == "failed":
-        return "failed", f"no buckling verdict: {res.get('message', '')}"
-    if not buckled and run_status not in ("completed", ""):
-        return "failed", f"run {run_status} before a verdict: {res.get('message', '')}"
-    return "ok", None
-
-
-def case_row(case: Case, key: str | None = None) -> dict:
-    """The parameter part of a case's row."""
-    from flagwrap import __version__
-
-    return {"key": key or case.key, "version": __version__, **case.to_dict()}
-
-
-def run_case(case: Case, root) -> dict:
-    """Run one case, write its run file and row (atomically) under ``root``, return the row.
-
-    Never raises for a failure of the case itself: the row then has ``status = "failed"``,
-    ``state = "failed"`` and ``error`` = ``"ExceptionType: message"``.
-    """
-    store = SweepStore(root)
-    key = case.key
-    row = case_row(case, key)
-    path = store.run_path(key)
-    t0 = time.perf_counter()
-    try:
-        fn = resolve_runner(case.runner)
-        res = fn(case.config(), path, case.run.get("stop_after"))
-        for k in RESULT_KEYS:
-            if k in res:
-                row[k] = res[k]
-        row["status"], row["error"] = verdict(res)
-    except Exception as exc:  # a failed case is a result, not the end of the sweep
-        row.update(status="failed", state="failed", buckled=None,
-                   error=f"{type(exc).__name__}: {exc}")
-    row["wall_time_s"] = time.perf_counter() - t0
-    row["finished_at"] = _now_iso()
-    row["host"] = socket.gethostname()
-    row["run_file"] = str(path) if path.is_file() else None
-    store.write_row(row)
-    return row
 
 
 @dataclass
@@ -246,10 +185,3 @@ def run_sweep(spec: SweepSpec, root, scheduler=None, n_workers=None, retry_faile
 
 def fmt_float(v, f=".3g"):
     return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, f)
-
-
-def _now_iso() -> str:
-    """The current time as ISO 8601 in UTC with seconds (rows and tables: readable, sortable)."""
-    import datetime
-
-    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
