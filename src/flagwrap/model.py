@@ -127,7 +127,15 @@ class RodSystem:
 
     # packing -------------------------------------------------------------------------------
     def initial_y(self) -> np.ndarray:
-        return self.pack(self.x0, self.theta0, 0.0)
+        """The initial state: the rest shape, displaced by ``config.initial`` if it asks
+        (the clamp's beads are not free unknowns, so they stay where the clamp holds them)."""
+        ini = self.config.initial
+        if ini.perturbation == 0.0:
+            return self.pack(self.x0, self.theta0, 0.0)
+        from flagwrap.geometry.perturbation import displacement
+
+        dx = displacement(self.N, ini.perturbation / self.config.filament.length, ini.mode, ini.seed)
+        return self.pack(self.x0 + dx, self.theta0, 0.0)
 
     def pack(self, x, theta, phi) -> np.ndarray:
         y = np.empty(self.ny)

@@ -523,6 +523,38 @@ class Numerics:
 
 
 @dataclass(frozen=True)
+class Initial:
+    """The initial state: the stress-free rest shape, optionally perturbed (issue 15).
+
+    ``perturbation`` [m]: the largest displacement of a bead from the rest shape (0: start at
+    rest, the default). ``mode = "random"``: a smooth random displacement field, the sum of the
+    first four sine modes along the contour in each direction with normal random amplitudes
+    from ``seed``; ``"lateral"``: along x. Both grow as ``(s/L)^2`` from the clamp, so the
+    clamped beads stay put and the rod leaves the clamp smoothly. A seed perturbation breaks the
+    symmetry a buckling instability would otherwise wait on round-off to break.
+    """
+
+    perturbation: float = 0.0
+    mode: str = "random"
+    seed: int = 0
+
+    MODES = ("random", "lateral")
+
+    def __post_init__(self):
+        v = _finite("initial.perturbation", self.perturbation)
+        if v < 0:
+            raise UserInputError(f"initial.perturbation must be >= 0 m, got {v!r}")
+        if self.mode not in self.MODES:
+            raise UserInputError(f"initial.mode must be one of {', '.join(self.MODES)}, got {self.mode!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2**63:
+            raise UserInputError(f"initial.seed must be an integer in [0, 2^63), got {self.seed!r}")
+
+    @property
+    def is_default(self) -> bool:
+        return self.perturbation == 0.0 and self.mode == "random" and self.seed == 0
+
+
+@dataclass(frozen=True)
 class Config:
     """Everything that defines one run."""
 
@@ -533,6 +565,7 @@ class Config:
     contact: Contact = field(default_factory=Contact)
     numerics: Numerics = field(default_factory=Numerics)
     clamp: Clamp = field(default_factory=Clamp)
+    initial: Initial = field(default_factory=Initial)
     name: str = "run"
 
     def __post_init__(self):
@@ -544,6 +577,7 @@ class Config:
             ("contact", Contact),
             ("numerics", Numerics),
             ("clamp", Clamp),
+            ("initial", Initial),
         ):
             if not isinstance(getattr(self, attr), cls):
                 raise UserInputError(f"config.{attr} must be a {cls.__name__}")
@@ -681,6 +715,8 @@ class Config:
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)
         if for_hash:
+            if self.initial.is_default:  # added after results were stored: default keeps keys
+                d.pop("initial", None)
             for k, v in Numerics.HASH_OMIT_DEFAULTS.items():
                 if d["numerics"].get(k) == v:
                     d["numerics"].pop(k)

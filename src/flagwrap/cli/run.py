@@ -33,6 +33,12 @@ def add_arguments(p):
     p.add_argument("--no-hi", action="store_true", help="switch long-range hydrodynamics off")
     p.add_argument("--integrator", choices=["ros34pw2", "ros2", "euler"], help="override numerics.integrator")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--perturb", type=float, default=None, metavar="METRES",
+                   help="start from the rest shape displaced by at most this much (overrides "
+                        "initial.perturbation; 0 = at rest)")
+    p.add_argument("--seed", type=int, default=None, help="seed of the random perturbation (initial.seed)")
+    p.add_argument("--perturb-mode", choices=["random", "lateral"], default=None,
+                   help="shape of the perturbation (initial.mode)")
     p.add_argument("--checkpoint", metavar="PATH", help="checkpoint file (default <output>.ckpt.h5)")
     p.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
                    help="also checkpoint every N accepted steps (default: off)")
@@ -58,7 +64,17 @@ def load(args):
         num = dataclasses.replace(num, hydrodynamics=False)
     if args.integrator:
         num = dataclasses.replace(num, integrator=args.integrator)
-    return cfg.replace(numerics=num)
+    ini = cfg.initial
+    changes = {k: v for k, v in (("perturbation", getattr(args, "perturb", None)),
+                                 ("seed", getattr(args, "seed", None)),
+                                 ("mode", getattr(args, "perturb_mode", None))) if v is not None}
+    if changes:
+        try:
+            ini = dataclasses.replace(ini, **changes)
+        except UserInputError as exc:  # name the option, not the config key
+            raise UserInputError(str(exc).replace("initial.perturbation", "--perturb")
+                                 .replace("initial.seed", "--seed")) from None
+    return cfg.replace(numerics=num, initial=ini)
 
 
 def run(args) -> int:

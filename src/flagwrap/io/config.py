@@ -22,7 +22,8 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from flagwrap.errors import UserInputError
-from flagwrap.params import CellBody, Clamp, Config, Contact, Filament, Fluid, Motor, Numerics, Phase
+from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Fluid, Initial, Motor,
+                             Numerics, Phase)
 
 _SECTIONS = {
     "filament": Filament,
@@ -32,6 +33,7 @@ _SECTIONS = {
     "contact": Contact,
     "numerics": Numerics,
     "clamp": Clamp,
+    "initial": Initial,
 }
 _LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "micron": 1e-6, "nm": 1e-9}
 _PRESSURE = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
@@ -40,6 +42,7 @@ _DENSITY = {"kg/m3": 1.0, "g/cm3": 1e3}
 _LENGTH_KEYS = {
     "filament": ("length", "helix_radius", "pitch", "cross_section_radius", "hydrodynamic_radius"),
     "body": ("radius", "cylinder_length"),
+    "initial": ("perturbation",),
 }
 
 
@@ -178,7 +181,9 @@ def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
     ``for_hash``: the text result keys are computed from (see ``Config.to_dict``)."""
     d = cfg.to_dict(for_hash=for_hash)
     lines = [f"name = {_toml_value(d.pop('name'))}", ""]
-    for section in ("filament", "fluid", "body", "motor", "clamp", "contact", "numerics"):
+    for section in ("filament", "fluid", "body", "motor", "clamp", "contact", "numerics", "initial"):
+        if section == "initial" and section not in d:
+            continue  # omitted from the hashed text while it holds its defaults
         table = d.get(section, {})
         lines.append(f"[{section}]")
         for k, v in table.items():
