@@ -33,6 +33,7 @@ from flagwrap.geometry.helix import filament_positions
 from flagwrap.hydrodynamics.mobility import make_mobility
 from flagwrap.motor.clamp import AxialClamp
 from flagwrap.motor.protocol import Schedule
+from flagwrap.system.layout import DofLayout
 
 
 @dataclass
@@ -88,9 +89,10 @@ class RodSystem:
         self.nc, self.ec = nc, ec
         self.nb = N - nc  # free beads
         self.ne = N - 1 - ec  # free bonds
-        self.ny = 3 * self.nb + self.ne + 1
-        self.sl_x = slice(0, 3 * self.nb)
-        self.sl_th = slice(3 * self.nb, 3 * self.nb + self.ne)
+        self.layout = DofLayout.clamped_filament(self.nb, self.ne)
+        self.ny = self.layout.size
+        self.sl_x = self.layout["x"]
+        self.sl_th = self.layout["theta"]
         # hydrodynamics (radius in core units)
         self.radius = fil.bead_radius / L
         num = config.numerics

@@ -46,7 +46,7 @@ class Estimate:
     output_memory: float
     linalg_memory: float
     file_bytes: float
-    unknowns: int  # ny: 3 (N - 2) bead coordinates + (N - 3) twists + the motor angle
+    unknowns: int  # ny: 3 (N - 2) bead coordinates + (N - 2) twists + the motor angle
 
     @property
     def memory(self) -> float:
@@ -72,7 +72,11 @@ def estimate(config) -> Estimate:
     turns = total_turns(config)
     n_saves = turns / num.save_every + 2.0
     frame = 8 * (3 * N + 3 * (N - 1) + (N - 1) + 8)
-    ny = 4 * N - 7  # free coordinates (Estimate.unknowns)
+    from flagwrap.motor.clamp import AxialClamp
+    from flagwrap.system.layout import DofLayout
+
+    # free coordinates (Estimate.unknowns): the layout RodSystem builds, 4 N - 7 with the clamp
+    ny = DofLayout.clamped_filament(N - AxialClamp.n_beads, N - 1 - AxialClamp.n_edges).size
     dense = num.hydrodynamics and _dense_solver(num.linear_solver, ny)
     linalg = 5.0 * 8.0 * ny * ny if dense else 200.0 * 8.0 * ny
     return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame, ny)

@@ -103,8 +103,8 @@ class Equilibrium:
 
 
 def _stiffness(system, y, base):
-    n = system.ny - 1  # the motor angle is held
-    K = -system.force_jacobian(y, base)[:n, :n]
+    free = system.layout.free()  # the motor angle is held
+    K = -system.force_jacobian(y, base)[np.ix_(free, free)]
     return 0.5 * (K + K.T)  # symmetric up to the finite-difference error
 
 
@@ -128,12 +128,12 @@ def equilibrium(system, y0=None, base=None, tol: float = 1e-8, xtol: float = 1e-
         no convergence to ``tol`` in ``max_iter`` iterations (past a static limit point
         there is no nearby equilibrium).
     """
-    n = system.ny - 1
+    n = system.layout.free()
     y = system.initial_y() if y0 is None else np.array(y0, float)
     base = system.frames0.copy() if base is None else base
     info = system.forces(y, base)
     base = info.frames
-    res = float(np.max(np.abs(info.G[:n])))
+    res = float(np.max(np.abs(info.G[n])))
     it = 0
     dx = np.inf
     while res > tol and dx > xtol:
@@ -142,13 +142,13 @@ def equilibrium(system, y0=None, base=None, tol: float = 1e-8, xtol: float = 1e-
                                f"iterations (residual {res:.3g})")
         it += 1
         K = _stiffness(system, y, base)
-        dy = np.linalg.solve(K, info.G[:n])
+        dy = np.linalg.solve(K, info.G[n])
         step = 1.0
         while True:  # backtracking on the potential energy, which Newton's step decreases
             y_try = y.copy()  # while K > 0 (the residual may grow: the stiff bonds' curvature)
-            y_try[:n] += step * dy
+            y_try[n] += step * dy
             info_try = system.forces(y_try, base)
-            res_try = float(np.max(np.abs(info_try.G[:n])))
+            res_try = float(np.max(np.abs(info_try.G[n])))
             if (_potential(system, info_try) <= _potential(system, info) + 1e-12 or res_try < res
                     or step < 1e-4):
                 break

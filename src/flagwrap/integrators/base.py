@@ -72,16 +72,12 @@ class AdaptiveMixin:
 
 
 def scaled_error(system, err: np.ndarray, tol: float) -> float:
-    """Max-norm of the local error: positions against ``tol`` [L], twist angles against ``10 tol``."""
-    ex = np.abs(err[system.sl_x]).max() / tol if system.nb else 0.0
-    et = np.abs(err[system.sl_th]).max() / (10.0 * tol) if system.ne else 0.0
-    return float(max(ex, et))
+    """Max-norm of the local error: positions against ``tol`` [L], twist angles against
+    ``10 tol`` (:meth:`flagwrap.system.layout.DofLayout.scaled_error`)."""
+    return system.layout.scaled_error(err, tol)
 
 
 def error_weights(system, tol: float) -> np.ndarray:
     """The absolute error each unknown is held to by :func:`scaled_error` (``inf`` for the
     prescribed motor angle): positions ``tol``, twist angles ``10 tol``."""
-    w = np.full(system.ny, np.inf)
-    w[system.sl_x] = tol
-    w[system.sl_th] = 10.0 * tol
-    return w
+    return system.layout.error_weights(tol)
