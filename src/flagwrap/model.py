@@ -93,6 +93,7 @@ class RodSystem:
         self.ny = self.layout.size
         self.sl_x = self.layout["x"]
         self.sl_th = self.layout["theta"]
+        self.i_phi = self.layout.block("phi").start  # the motor angle's index in y
         # hydrodynamics (radius in core units)
         self.radius = fil.bead_radius / L
         num = config.numerics
@@ -143,11 +144,11 @@ class RodSystem:
         y = np.empty(self.ny)
         y[self.sl_x] = x[self.nc:].ravel()
         y[self.sl_th] = theta[self.ec:]
-        y[-1] = phi
+        y[self.i_phi] = phi
         return y
 
     def unpack(self, y):
-        phi = y[-1]
+        phi = y[self.i_phi]
         x = np.empty((self.N, 3))
         x[: self.nc] = self.clamp.positions(phi)
         x[self.nc:] = y[self.sl_x].reshape(-1, 3)
@@ -192,13 +193,13 @@ class RodSystem:
         apply = self.mobility.apply_single if single else self.mobility.apply
         out[self.sl_x] = apply(x[self.nc:], Fx).ravel() / self.machin
         out[self.sl_th] = G[self.sl_th] / (self.machin * self.rot_drag[self.ec:])
-        out[-1] = 0.0
+        out[self.i_phi] = 0.0
         return out
 
     def rhs(self, y, base, omega):
         info = self.forces(y, base)
         f = self.apply_mobility(y, info.G)
-        f[-1] = omega
+        f[self.i_phi] = omega
         return f, info
 
     def local_mobility_diagonal(self) -> np.ndarray:

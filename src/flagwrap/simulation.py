@@ -107,8 +107,9 @@ class Simulation:
         material_frames(info.frames.t, info.frames.d1, info.theta, m1, m2)
         # everything computed before anything is appended: an interrupt in between must not
         # leave the records with different lengths
-        row = (t, info.x.copy(), info.theta.copy(), m1, y[-1], omega,
-               s.motor_torque(info, y[-1], omega), info.elastic_energy, info.contact_energy,
+        phi = y[s.i_phi]
+        row = (t, info.x.copy(), info.theta.copy(), m1, phi, omega,
+               s.motor_torque(info, phi, omega), info.elastic_energy, info.contact_energy,
                float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf,
                self._strain(info))
         for name, value in zip(_RECORDS, row):

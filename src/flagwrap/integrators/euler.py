@@ -19,7 +19,7 @@ class ExplicitEuler(Integrator):
 
     def step(self, system, y, base, info, h, omega) -> StepResult:
         f = system.apply_mobility(y, info.G)
-        f[-1] = omega
+        f[system.i_phi] = omega
         y_new = y + h * f
         if not np.all(np.isfinite(y_new)):
             return StepResult(False, None, None, h, np.nan, "non-finite state")

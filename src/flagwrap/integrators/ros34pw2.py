@@ -65,7 +65,7 @@ class ROS34PW2(AdaptiveMixin, Integrator):
         for i in range(s):
             if i == 0:
                 f = system.apply_mobility(y, info.G)
-                f[-1] = omega
+                f[system.i_phi] = omega
             else:
                 Yi = y + A_T[i, :i] @ U[:i]
                 if not np.all(np.isfinite(Yi)):

@@ -38,7 +38,7 @@ class ROS2(AdaptiveMixin, Integrator):
     def step(self, system, y, base, info, h, omega) -> StepResult:
         G0 = info.G
         f0 = system.apply_mobility(y, G0)
-        f0[-1] = omega
+        f0[system.i_phi] = omega
         try:
             # the stages k_i are rates: y moves by ~h k_i, so an iterative solve needs them to
             # kappa x tol / h
