@@ -201,6 +201,16 @@ class Filament:
                 f"cross_section_radius={a:g} m, more than {MAX_BOND_OVER_RADIUS:g}: beads that far apart "
                 f"are separate spheres, not a filament (their drag per length falls as a/b); {fix}")
 
+    def with_density(self, density: float) -> "Filament":
+        """A copy with ``density`` [kg m^-3] and no ``density_mismatch`` (the resolved pitch
+        inputs forbid ``dataclasses.replace``; the copy leaves the caller's Filament alone)."""
+        import copy
+
+        fil = copy.copy(self)
+        _set(fil, "density", _positive("filament.density", density, "kg/m^3"))
+        _set(fil, "density_mismatch", None)
+        return fil
+
     # derived -------------------------------------------------------------------------------
     @property
     def bending_modulus(self) -> float:
@@ -551,7 +561,7 @@ class Initial:
 
     @property
     def is_default(self) -> bool:
-        return self.perturbation == 0.0 and self.mode == "random" and self.seed == 0
+        return self == Initial()
 
 
 @dataclass(frozen=True)
@@ -591,11 +601,7 @@ class Config:
                     f"filament.density_mismatch={fil.density_mismatch!r} with fluid.density="
                     f"{self.fluid.density!r} kg/m^3 gives no positive filament density; give "
                     "filament.density instead")
-            import copy
-
-            fil = copy.copy(fil)  # a copy: the caller's Filament may serve other configs
-            _set(fil, "density", rho)
-            _set(fil, "density_mismatch", None)
+            fil = fil.with_density(rho)
             _set(self, "filament", fil)
         if self.body.enabled:
             rc = self.body.resolved_radius(fil.helix_radius)

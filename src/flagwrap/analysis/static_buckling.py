@@ -17,7 +17,7 @@ dynamics ``dy/dt = Mob G`` with a positive definite mobility has the same stable
 does not depend on the hydrodynamics; only the growth rate does.
 
 Uses: the independent check of the gravity implementation against Greenhill's value
-(:func:`straight_rod_system`, :func:`critical_gravity`; tests/validation/test_gravity.py) and
+(:func:`straight_rod_system`, :func:`critical_gravity`; tests/validation/test_greenhill.py) and
 the static (M -> 0) limit of the buoyant helix (docs/gravity.md).
 """
 
@@ -48,11 +48,7 @@ def with_gravity_number(config, G: float):
     if not (math.isfinite(rho) and rho > 0):
         raise UserInputError(f"gravity number G = {G!r} needs a filament density {rho:g} kg/m^3 "
                              f"<= 0 (the fluid's is {config.fluid.density:g})")
-    import copy
-
-    new = copy.copy(fil)  # Filament's resolved pitch inputs forbid dataclasses.replace
-    object.__setattr__(new, "density", rho)
-    return dataclasses.replace(config, filament=new)
+    return dataclasses.replace(config, filament=fil.with_density(rho))
 
 
 def straight_positions(n_beads: int) -> np.ndarray:
@@ -102,6 +98,14 @@ class Equilibrium:
         return bool(self.eigenvalues[0] > 0)
 
 
+def _system_at(config, G: float, straight: bool):
+    """The system of ``config`` at gravity number ``G``: straight rest shape or its own helix."""
+    from flagwrap.model import RodSystem
+
+    cfg = with_gravity_number(config, G)
+    return straight_rod_system(cfg) if straight else RodSystem(cfg)
+
+
 def _stiffness(system, y, base):
     free = system.layout.free()  # the motor angle is held
     K = -system.force_jacobian(y, base)[np.ix_(free, free)]
@@ -144,13 +148,13 @@ def equilibrium(system, y0=None, base=None, tol: float = 1e-8, xtol: float = 1e-
         K = _stiffness(system, y, base)
         dy = np.linalg.solve(K, info.G[n])
         step = 1.0
+        U0 = _potential(system, info)
         while True:  # backtracking on the potential energy, which Newton's step decreases
             y_try = y.copy()  # while K > 0 (the residual may grow: the stiff bonds' curvature)
             y_try[n] += step * dy
             info_try = system.forces(y_try, base)
             res_try = float(np.max(np.abs(info_try.G[n])))
-            if (_potential(system, info_try) <= _potential(system, info) + 1e-12 or res_try < res
-                    or step < 1e-4):
+            if _potential(system, info_try) <= U0 + 1e-12 or res_try < res or step < 1e-4:
                 break
             step *= 0.5
         dx = float(np.max(np.abs(step * dy)))
@@ -176,13 +180,9 @@ def critical_gravity(config, G_lo: float, G_hi: float, rtol: float = 1e-4, strai
     ValueError
         ``G_lo`` is not stable or ``G_hi`` not unstable.
     """
-    from flagwrap.model import RodSystem
-
     def solve(G, start=None):
-        cfg = with_gravity_number(config, G)
-        sys_ = straight_rod_system(cfg) if straight else RodSystem(cfg)
         y0, base = (None, None) if start is None else (start.y, start.base)
-        return equilibrium(sys_, y0, base)
+        return equilibrium(_system_at(config, G, straight), y0, base)
 
     lo = solve(G_lo)
     if not lo.stable:
@@ -240,14 +240,11 @@ class StaticBranch:
 def static_branch(config, G_values, straight: bool = False, max_iter: int = 200) -> StaticBranch:
     """Continue the static equilibrium of ``config``'s filament (motor at rest) through the
     increasing gravity numbers ``G_values`` (each solve starts from the previous one)."""
-    from flagwrap.model import RodSystem
-
     G_values = np.asarray(sorted(float(g) for g in G_values))
     out = {k: [] for k in ("G", "tip_z", "tip_offset", "lowest")}
     prev, z0, msg = None, None, ""
     for G in G_values:
-        cfg = with_gravity_number(config, G)
-        s = straight_rod_system(cfg) if straight else RodSystem(cfg)
+        s = _system_at(config, G, straight)
         try:
             e = equilibrium(s, *((prev.y, prev.base) if prev is not None else (None, None)),
                             max_iter=max_iter)

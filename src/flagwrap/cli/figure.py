@@ -94,9 +94,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from flagwrap.io.outputs import check_output_dir
-
     from pathlib import Path
+
+    from flagwrap.io.outputs import check_output_dir
 
     check_output_dir(args.outdir, "figure folder (-o)")
     cached = ", ".join(f"{d}: {len(list(Path(d).glob('*.nc')))} cached runs" for d in CACHES.get(args.name, ()))

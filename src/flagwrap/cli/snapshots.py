@@ -48,9 +48,8 @@ def run(args) -> int:
 
     for f in formats:
         check_output_file(out.with_suffix("." + f), "snapshot file (-o)")
-    if args.times is not None:
-        if len(args.times) > 50:
-            raise UserInputError(f"-t/--times: at most 50 times, got {len(args.times)}")
+    if args.times is not None and len(args.times) > 50:
+        raise UserInputError(f"-t/--times: at most 50 times, got {len(args.times)}")
     paths = write_snapshots(ds, out, formats=formats, dpi=args.dpi, times=args.times, n=args.n)
     for p in paths:
         print(p)

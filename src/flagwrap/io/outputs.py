@@ -14,7 +14,6 @@ a stale lock). :func:`write_or_rescue` writes a finished result and, if the fina
 from __future__ import annotations
 
 import os
-import shutil
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -41,11 +40,11 @@ def _probe_writable(folder: Path, what: str, target: Path) -> None:
         raise UserInputError(f"{what} {target}: cannot write in {folder} ({exc.strerror or exc})") from None
 
 
-def check_output_file(path, what: str = "output", suffixes=None, need_bytes: float = 0.0) -> Path:
+def check_output_file(path, what: str = "output", suffixes=None) -> Path:
     """Raise :class:`UserInputError` unless ``path`` can be written as a file.
 
-    ``suffixes``: allowed suffixes (lower case, with the dot), or None for any; ``need_bytes``:
-    free space needed on its file system. Creates nothing.
+    ``suffixes``: allowed suffixes (lower case, with the dot), or None for any. Creates
+    nothing; a run's free space is :func:`flagwrap.resources.check_disk`'s.
     """
     p = Path(path)
     if str(path).strip() == "":
@@ -59,11 +58,6 @@ def check_output_file(path, what: str = "output", suffixes=None, need_bytes: flo
     if not anc.is_dir():
         raise UserInputError(f"{what} {p}: {anc} is a file, not a folder")
     _probe_writable(anc, what, p)
-    if need_bytes > 0:
-        free = shutil.disk_usage(anc).free
-        if need_bytes > free:
-            raise UserInputError(f"{what} {p} needs about {need_bytes / 1e9:.3g} GB, more than the "
-                                 f"{free / 1e9:.3g} GB free in {anc}")
     return p
 
 

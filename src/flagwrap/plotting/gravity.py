@@ -59,12 +59,14 @@ def diagram_fits(sweep_dir) -> list[dict]:
     from flagwrap.sweep.boundary import brackets_from_rows
     from flagwrap.sweep.store import SweepStore
 
-    rows = list(SweepStore(sweep_dir).iter_rows())
+    groups: dict = {}
+    for r in SweepStore(sweep_dir).iter_rows():
+        groups.setdefault(r.get("density_mismatch", 0.0), []).append(r)
     out = []
-    for dm in sorted({r.get("density_mismatch", 0.0) for r in rows}):
-        br = brackets_from_rows([r for r in rows if r.get("density_mismatch", 0.0) == dm])
-        G = next((r.get("gravity_number") for r in rows if r.get("density_mismatch", 0.0) == dm), None)
-        out.append({"density_mismatch": dm, "gravity_number": G, "fit": fit_boundary(br), "brackets": br})
+    for dm in sorted(groups):
+        br = brackets_from_rows(groups[dm])
+        out.append({"density_mismatch": dm, "gravity_number": groups[dm][0].get("gravity_number"),
+                    "fit": fit_boundary(br), "brackets": br})
     return out
 
 
@@ -80,7 +82,7 @@ def gravity_figure(outdir="out/figures", fig4a_sweep=FIG4A_SWEEP, fig5_sweep=FIG
     from flagwrap.cases import get_case
     from flagwrap.sweep.store import jsonable, write_json_atomic
 
-    table = [r for r in boundary_table(fig4a_sweep)] if Path(fig4a_sweep).is_dir() else []
+    table = boundary_table(fig4a_sweep) if Path(fig4a_sweep).is_dir() else []
     if not table:
         raise UserInputError(f"no boundary results in {fig4a_sweep}: run `flagwrap sweep "
                              "examples/sweeps/gravity-fig4a.toml` first")
