@@ -17,9 +17,11 @@ At interior vertex ``i`` (between bonds i-1 and i):
 Energy (dimensionless, A = 1 in the core units)::
 
     E = sum_j ks/2 (|e_j| - l0_j)^2
-      + sum_i A/(2 l_i) [(k1 - k1bar)^2 + (k2 - k2bar)^2] + C/(2 l_i) (m_i - mbar_i)^2
+      + sum_i cb_i/2 [(k1 - k1bar)^2 + (k2 - k2bar)^2] + ct_i/2 (m_i - mbar_i)^2
 
-with Voronoi length ``l_i = (l0_{i-1} + l0_i)/2``. Rest values are those of the initial helix,
+with per-vertex coefficients ``cb_i = A_i / l_i`` and ``ct_i = C_i / l_i`` (Voronoi length
+``l_i = (l0_{i-1} + l0_i)/2``; a uniform rod has ``A_i = A``, ``C_i = C``). A joint is a vertex
+with other coefficients: the lumped hook (:mod:`flagwrap.joints.hook`) sets ``cb_1 = A_h/l_h``. Rest values are those of the initial helix,
 so the stress-free helix is an exact minimum (E = 0).
 
 The gradient is exact for the energy evaluated with reference frames transported from a base
@@ -119,9 +121,11 @@ def curvatures(t, m1, m2, kb, kappa):
 
 
 @nb.njit(cache=True)
-def energy_grad(x, theta, base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, ks,
+def energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, kbar, mbar, ks,
                 grad_x, grad_th, d1_out, rt_out):
     """Elastic energy and its gradient (dE/dx (N,3), dE/dtheta (N-1)).
+
+    ``cbend``, ``ctwist`` (N,): the vertex coefficients ``A_i/l_i``, ``C_i/l_i`` (ends unused).
 
     ``grad_x``, ``grad_th`` are overwritten; ``d1_out`` (N-1,3) and ``rt_out`` (N) receive the
     transported reference directors and reference twist at ``x`` (the next base).
@@ -164,7 +168,7 @@ def energy_grad(x, theta, base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, k
         k2 = -0.5 * (mt10 * kb0 + mt11 * kb1 + mt12 * kb2) * chi
         d1 = k1 - kbar[i, 0]
         d2 = k2 - kbar[i, 1]
-        cb = A / vor[i]
+        cb = cbend[i]
         E += 0.5 * cb * (d1 * d1 + d2 * d2)
         inv_a = 1.0 / ln[i - 1]
         inv_b = 1.0 / ln[i]
@@ -198,7 +202,7 @@ def energy_grad(x, theta, base_t, base_d1, base_rt, l0, vor, kbar, mbar, A, C, k
         grad_th[i] += cb * (-0.5) * (d1 * kbm1b + d2 * kbm2b)
         # twist
         mtw = theta[i] - theta[i - 1] + rt_out[i] - mbar[i]
-        ct = C / vor[i]
+        ct = ctwist[i]
         E += 0.5 * ct * mtw * mtw
         grad_th[i] += ct * mtw
         grad_th[i - 1] -= ct * mtw

@@ -5,6 +5,7 @@ All quantities in core units (length L, energy A/L, A = 1): see :mod:`flagwrap.u
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +25,10 @@ class RestState:
     kbar : (N, 2) rest material curvatures (dimensionless turning, kb.m)
     mbar : (N,) rest twist (rad)
     bending, twist, stretch : float
-        ``A`` (=1), ``C`` [A], ``ks`` [A/L^3].
+        the rod's ``A`` (=1), ``C`` [A], ``ks`` [A/L^3].
+    cbend, ctwist : (N,) vertex coefficients ``A_i/l_i``, ``C_i/l_i`` the kernel uses
+        (``bending/vor``, ``twist/vor`` for a uniform rod; joints change theirs:
+        :meth:`with_vertex`). Ends unused (0).
     """
 
     l0: np.ndarray
@@ -34,6 +38,37 @@ class RestState:
     bending: float
     twist: float
     stretch: float
+    cbend: np.ndarray = None
+    ctwist: np.ndarray = None
+
+    def __post_init__(self):
+        if self.cbend is None:
+            object.__setattr__(self, "cbend", _coefficients(self.bending, self.vor))
+        if self.ctwist is None:
+            object.__setattr__(self, "ctwist", _coefficients(self.twist, self.vor))
+
+    def with_vertex(self, i: int, cbend: float | None = None, ctwist: float | None = None,
+                    kbar=None, mbar: float | None = None) -> "RestState":
+        """A copy with vertex ``i``'s coefficients and/or rest curvature/twist replaced."""
+        cb, ct = self.cbend.copy(), self.ctwist.copy()
+        kb, mb = self.kbar.copy(), self.mbar.copy()
+        if cbend is not None:
+            cb[i] = cbend
+        if ctwist is not None:
+            ct[i] = ctwist
+        if kbar is not None:
+            kb[i] = kbar
+        if mbar is not None:
+            mb[i] = mbar
+        return dataclasses.replace(self, cbend=cb, ctwist=ct, kbar=kb, mbar=mb)
+
+
+def _coefficients(modulus, vor: np.ndarray) -> np.ndarray:
+    """``modulus / vor`` at interior vertices, 0 at the ends; ``modulus``: scalar or (N,)."""
+    out = np.zeros(len(vor))
+    m = np.broadcast_to(np.asarray(modulus, float), vor.shape)
+    out[1:-1] = m[1:-1] / vor[1:-1]
+    return out
 
 
 @dataclass
@@ -77,8 +112,8 @@ def elastic_energy(x, theta, base: Frames, rest: RestState) -> float:
     gth = np.empty(len(theta))
     d1 = np.empty_like(base.d1)
     rt = np.empty_like(base.rt)
-    return K.energy_grad(x, theta, base.t, base.d1, base.rt, rest.l0, rest.vor, rest.kbar,
-                         rest.mbar, rest.bending, rest.twist, rest.stretch, gx, gth, d1, rt)
+    return K.energy_grad(x, theta, base.t, base.d1, base.rt, rest.l0, rest.cbend,
+                         rest.ctwist, rest.kbar, rest.mbar, rest.stretch, gx, gth, d1, rt)
 
 
 def elastic_forces(x, theta, base: Frames, rest: RestState):
@@ -87,8 +122,8 @@ def elastic_forces(x, theta, base: Frames, rest: RestState):
     gth = np.empty(len(theta))
     d1 = np.empty_like(base.d1)
     rt = np.empty_like(base.rt)
-    E = K.energy_grad(x, theta, base.t, base.d1, base.rt, rest.l0, rest.vor, rest.kbar,
-                      rest.mbar, rest.bending, rest.twist, rest.stretch, gx, gth, d1, rt)
+    E = K.energy_grad(x, theta, base.t, base.d1, base.rt, rest.l0, rest.cbend,
+                      rest.ctwist, rest.kbar, rest.mbar, rest.stretch, gx, gth, d1, rt)
     e = np.diff(x, axis=0)
     t = e / np.linalg.norm(e, axis=1)[:, None]
     return E, -gx, -gth, Frames(t, d1, rt)
