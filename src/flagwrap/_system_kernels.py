@@ -186,10 +186,13 @@ def band_from_triplets(rows, cols, vals, Mb, wd, mt, gamma_h, inv, kl, ku, n, ab
     ``Mob_near``: translational 3x3 blocks ``Mb[i, wd + k] = Mob_{i, i+k}`` for |k| <= wd
     (``wd = 0``: the local mobility) and the twist diagonal ``mt``. Each triplet ``J[r, c] = v``
     adds ``-gamma h Mob[:, r] v`` to column ``c``; ``ab`` (2 kl + ku + 1, n), Fortran order,
-    is zeroed here, ``ab[kl + ku + i - j, j] = W'[i, j]``.
+    is zeroed here, ``ab[kl + ku + i - j, j] = W'[i, j]``. A triplet outside the band (an
+    interaction whose pattern was not in the cached band structure) is left out: ``W`` is then
+    approximate, which the W-methods tolerate, instead of a write out of bounds.
     """
     nb3 = Mb.shape[0] * 3
     nbd = Mb.shape[0]
+    top = 2 * kl + ku
     ab[:, :] = 0.0
     w[:] = 0.0
     for q in range(rows.shape[0]):
@@ -211,13 +214,17 @@ def band_from_triplets(rows, cols, vals, Mb, wd, mt, gamma_h, inv, kl, ku, n, ab
                     if c == n:
                         w[i] += val
                     else:
-                        ab[kl + ku + inv[i] - inv[c], inv[c]] += val
+                        off = kl + ku + inv[i] - inv[c]
+                        if kl <= off <= top:  # a term outside the band is left out of W
+                            ab[off, inv[c]] += val
         else:
             val = mt[r - nb3] * v
             if c == n:
                 w[r] += val
             else:
-                ab[kl + ku + inv[r] - inv[c], inv[c]] += val
+                off = kl + ku + inv[r] - inv[c]
+                if kl <= off <= top:
+                    ab[off, inv[c]] += val
     for j in range(n):
         ab[kl + ku, j] += 1.0
 

@@ -31,7 +31,7 @@ from flagwrap.body.cell_body import CappedCylinder, NoBody
 from flagwrap.elasticity.rod import Frames, RestState, initial_frames, rest_state
 from flagwrap.geometry.helix import filament_positions
 from flagwrap.hydrodynamics.mobility import make_mobility
-from flagwrap.motor.clamp import AxialClamp
+from flagwrap.joints import make_joint
 from flagwrap.motor.protocol import Schedule
 from flagwrap.system.layout import DofLayout
 
@@ -49,43 +49,47 @@ class ForceInfo:
     grad_x: np.ndarray
     grad_theta: np.ndarray
     distance: np.ndarray
+    interaction_energy: float = 0.0
 
 
 class RodSystem:
     """Forces, mobility and bookkeeping of one run (core units)."""
 
-    def __init__(self, config, x0=None, theta0=None, body=None, clamp=None, mobility=None):
+    def __init__(self, config, x0=None, theta0=None, body=None, clamp=None, mobility=None,
+                 joint=None, interactions=()):
+        """``joint`` (or its old name ``clamp``): a built joint for the shape ``x0`` (default:
+        :func:`flagwrap.joints.make_joint` from ``config.joint``); ``interactions``: extra
+        energy terms (:mod:`flagwrap.interactions.base`) after those the config asks for."""
         self.config = config
         fil = config.filament
         L = fil.length
         self.scales = config.scales
         self.machin = config.machin
         x0 = filament_positions(fil, config.clamp) / L if x0 is None else np.asarray(x0, float)
+        theta0 = np.zeros(len(x0) - 1) if theta0 is None else np.asarray(theta0, float)
+        joint = joint or clamp
+        if joint is None:  # the joint may add beads (a resolved hook): it returns the shape
+            joint, x0, theta0 = make_joint(config, x0, theta0)
         N = len(x0)
         self.N = N
-        theta0 = np.zeros(N - 1) if theta0 is None else np.asarray(theta0, float)
         frames = initial_frames(x0)
         b = fil.bond_length / L
         self.bond = b
         # Step of the coloured finite-difference Jacobian, a fixed fraction of the bond: bending
         # and twist forces depend on displacements through angles ~ dx / b, so this keeps the
-        # relative accuracy of J the same at every N (1e-7 L at the paper's N = 61, the value
-        # used before). A fixed 1e-7 L is 1e-4 b at N = 1000 and 4e-4 b at N = 4000, and the
-        # W-method then lost stability at shorter steps (measured on benchmarks/scaling.py's
-        # chain: N = 1000 1.36 vs 4.56 simulated turns per wall hour with this step; N = 4000
-        # accepted steps ~1e-7..1e-6 vs ~1e-5 /omega).
+        # relative accuracy of J the same at every N (docs/numerics.md, "Jacobian step").
         self.fd_step = 6e-6 * b
-        self.rest: RestState = rest_state(
+        self.joint = self.clamp = joint
+        self.rest: RestState = joint.rest(rest_state(
             x0, frames, theta0,
             bending=1.0,
             twist=fil.twist_modulus / fil.bending_modulus,
             stretch=fil.stretch_stiffness / b**3,
-        )
+        ))
         self.frames0 = frames
         self.x0 = x0
         self.theta0 = theta0
-        self.clamp = clamp or AxialClamp(x0, theta0)
-        nc, ec = self.clamp.n_beads, self.clamp.n_edges
+        nc, ec = joint.n_beads, joint.n_edges
         self.nc, self.ec = nc, ec
         self.nb = N - nc  # free beads
         self.ne = N - 1 - ec  # free bonds
@@ -99,7 +103,7 @@ class RodSystem:
         num = config.numerics
         self.mobility = mobility or make_mobility(
             num.hydrodynamics, self.radius, backend=num.mobility_backend,
-            n=config.filament.n_beads, threads=num.threads, fmm_eps=num.mobility_tol)
+            n=N, threads=num.threads, fmm_eps=num.mobility_tol)
         w = np.ones(N - 1)
         w[0] += 0.5
         w[-1] += 0.5
@@ -122,11 +126,27 @@ class RodSystem:
         # contour l (half a bond at the ends): units.gravity_number
         self.gravity = np.zeros((N, 3))
         if fil.density is not None:
-            per_bead = np.full(N, b)
-            per_bead[0] = per_bead[-1] = 0.5 * b
+            # half of each adjacent bond's nominal length (b, or a hook's short bonds)
+            lb = np.where(np.abs(self.rest.l0 - b) < 1e-9 * b, b, self.rest.l0)
+            per_bead = np.empty(N)
+            per_bead[0], per_bead[-1] = 0.5 * lb[0], 0.5 * lb[-1]
+            per_bead[1:-1] = 0.5 * (lb[:-1] + lb[1:])
             self.gravity[:, 2] = config.gravity_number * per_bead
         self.schedule = Schedule(config.motor.protocol)
         self._colors = None
+        self.interactions = self._config_interactions() + list(interactions)
+
+    def _config_interactions(self) -> list:
+        c = self.config.contact
+        if not c.self_contact:
+            return []
+        from flagwrap.interactions.self_contact import SelfContact, SelfContactInteraction
+
+        sc = SelfContact(self.config.filament.cross_section_radius / self.config.filament.length,
+                         self.bond, range=c.resolved_self_range,
+                         strength=c.resolved_self_strength / self.bond,
+                         c2=1.0 if c.potential == "wca-c2" else 0.0, rest_lengths=self.rest.l0)
+        return [SelfContactInteraction(sc)]
 
     # packing -------------------------------------------------------------------------------
     def initial_y(self) -> np.ndarray:
@@ -180,9 +200,57 @@ class RodSystem:
         dist = np.empty(N)
         E, Ec = SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base),
                                       G, x, theta, gx, gth, d1, rt, dist)
+        Ei = 0.0
+        if self.interactions:
+            gxe = np.zeros((N, 3))
+            gthe = np.zeros(N - 1)
+            for it in self.interactions:
+                Ei += it.energy_grad(x, theta, gxe, gthe)
+            G[self.sl_x] -= gxe[self.nc:].ravel()
+            G[self.sl_th] -= gthe[self.ec:]
+            gx += gxe
+            gth += gthe
         t = np.empty((N - 1, 3))
         SK.unit_tangents(x, t)
-        return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist)
+        return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist, Ei)
+
+    def _core_G(self, y, base) -> np.ndarray:
+        """``G`` of the fused kernel alone (without the interactions)."""
+        N = self.N
+        G = np.empty(self.ny)
+        SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base), G,
+                              np.empty((N, 3)), np.empty(N - 1), np.empty((N, 3)),
+                              np.empty(N - 1), np.empty_like(base.d1), np.empty_like(base.rt),
+                              np.empty(N))
+        return G
+
+    def interaction_jacobian_coo(self, y, which: str = "all"):
+        """``-d^2U/dy^2`` of the interactions as triplets over the unknowns; ``which``: "all",
+        "local" or "nonlocal" (by ``nonlocal_hessian``). Clamped coordinates are dropped."""
+        parts = []
+        if not self.interactions:
+            return parts
+        x, theta, _ = self.unpack(y)
+        N, nc, ec = self.N, self.nc, self.ec
+        x0, t0 = self.sl_x.start, self.sl_th.start
+        for it in self.interactions:
+            nl = bool(getattr(it, "nonlocal_hessian", False))
+            if (which == "local" and nl) or (which == "nonlocal" and not nl):
+                continue
+            h = it.hessian_coo(x, theta) if hasattr(it, "hessian_coo") else None
+            if h is None:
+                continue
+            r, c, v = (np.asarray(a) for a in h)
+            idx = []
+            for f in (r, c):
+                bead = f < 3 * N
+                yi = np.where(bead, x0 + f - 3 * nc, t0 + (f - 3 * N) - ec)
+                ok = np.where(bead, f // 3 >= nc, (f - 3 * N) >= ec)
+                idx.append((yi, ok))
+            keep = idx[0][1] & idx[1][1]
+            parts.append((idx[0][0][keep].astype(np.int64), idx[1][0][keep].astype(np.int64),
+                          -np.asarray(v, float)[keep]))
+        return parts
 
     def apply_mobility(self, y: np.ndarray, G: np.ndarray, single: bool = False) -> np.ndarray:
         """``Mob(y) G`` without the motor term; ``single``: to float32 accuracy
@@ -298,20 +366,29 @@ class RodSystem:
         )
 
     def force_jacobian_coo(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
-                           delta: float | None = None):
+                           delta: float | None = None, nonlocal_terms: bool = True):
         """``dG/dy`` as COO triplets (rows, cols, vals; duplicates add), O(N) work and memory.
 
-        ``delta``: difference step, default ``fd_step``.
+        ``delta``: difference step, default ``fd_step``. ``nonlocal_terms``: include the
+        interactions whose Hessians couple beads far apart along the chain (the banded
+        solvers pass False). The interactions' terms are their own Hessians
+        (:meth:`interaction_jacobian_coo`), appended to the kernel's coloured differences.
         """
         if delta is None:
             delta = self.fd_step
         if self._colors is None:
             self._build_colors()
-        if G0 is None:
+        if self.interactions:  # the kernel differences its own forces: it needs its own G
+            G0 = self._core_G(y, base)
+        elif G0 is None:
             G0 = self.forces(y, base).G
         g_ptr, g_cols, e_ptr, e_rows, e_cols = self._colors_flat
-        return SK.fd_jacobian_coo(np.ascontiguousarray(y), G0, delta, g_ptr, g_cols, e_ptr,
+        trip = SK.fd_jacobian_coo(np.ascontiguousarray(y), G0, delta, g_ptr, g_cols, e_ptr,
                                   e_rows, e_cols, self.N, *self._kernel_args(base))
+        extra = self.interaction_jacobian_coo(y, "all" if nonlocal_terms else "local")
+        if not extra:
+            return trip
+        return tuple(np.concatenate([trip[k]] + [e[k] for e in extra]) for k in range(3))
 
     def force_jacobian(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
                        delta: float | None = None) -> np.ndarray:

@@ -387,6 +387,64 @@ class Clamp:
 
 
 @dataclass(frozen=True)
+class Joint:
+    """The joint between the motor and the filament (issue 15; docs/hook.md).
+
+    ``kind = "clamp"`` (default): the paper's rig. The motor holds the first bond rigidly; the
+    vertex where the filament leaves it bends with the filament's own stiffness ``A / b``.
+
+    ``kind = "hook"``: the flagellar hook, a short elastic joint of length ``hook_length``
+    ``l_h`` [m], bending stiffness ``hook_bending_modulus`` ``A_h`` [N m^2] and twist stiffness
+    ``hook_twist_modulus`` ``C_h`` [N m^2]. ``hook_segments = 0`` (default) lumps it into one
+    vertex between the motor axis and the first free bond, a bending spring ``A_h / l_h``
+    and a twist spring ``C_h / l_h`` (right for a hook much shorter than a bond: ``l_h/L ~ 1e-2``
+    against ``b/L = 1/60``); ``hook_segments = n >= 2`` resolves it as ``n`` bonds of length
+    ``l_h / n`` inserted between the motor's bond and the filament (which keeps its own beads).
+    ``hook_twist_modulus`` unset: ``C_h`` = the filament's ``C``, a torque-transmitting hook
+    (``C_h / l_h >= C / b``). The universal-joint limit is ``A_h -> 0`` (a small positive value:
+    zero stiffness is refused as a typo). Bacterial values and their sources: docs/hook.md.
+    """
+
+    kind: str = "clamp"
+    hook_length: float | None = None
+    hook_bending_modulus: float | None = None
+    hook_twist_modulus: float | None = None
+    hook_segments: int = 0
+
+    KINDS = ("clamp", "hook")
+    MAX_SEGMENTS = 50
+
+    def __post_init__(self):
+        if self.kind not in self.KINDS:
+            raise UserInputError(f"joint.kind must be one of {', '.join(self.KINDS)}, got {self.kind!r}")
+        hook_keys = ("hook_length", "hook_bending_modulus", "hook_twist_modulus")
+        if self.kind == "clamp":
+            given = [k for k in hook_keys if getattr(self, k) is not None]
+            if given or self.hook_segments:
+                raise UserInputError(f"joint.{(given or ['hook_segments'])[0]} needs joint.kind = 'hook' "
+                                     "(the clamp has no hook parameters)")
+            return
+        for k, unit in (("hook_length", "m"), ("hook_bending_modulus", "N m^2")):
+            if getattr(self, k) is None:
+                raise UserInputError(f"joint.{k} is required with joint.kind = 'hook' ({unit}; "
+                                     "bacterial values in docs/hook.md)")
+        _positive("joint.hook_length", self.hook_length, "m")
+        _positive("joint.hook_bending_modulus", self.hook_bending_modulus,
+                  "N m^2 (for the universal-joint limit give a small value, e.g. 1e-30)")
+        if self.hook_twist_modulus is not None:
+            _positive("joint.hook_twist_modulus", self.hook_twist_modulus, "N m^2")
+        n = self.hook_segments
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not (
+                n == 0 or 2 <= n <= self.MAX_SEGMENTS):
+            raise UserInputError(f"joint.hook_segments must be 0 (lumped) or an integer in "
+                                 f"[2, {self.MAX_SEGMENTS}] (resolved), got {n!r}")
+
+    @property
+    def is_default(self) -> bool:
+        return self == Joint()
+
+
+@dataclass(frozen=True)
 class Contact:
     """Short-ranged repulsion between beads and the cell body (WCA form).
 
@@ -399,17 +457,42 @@ class Contact:
     case psi 45, n 2, M 5388, 5 + 7 turns, ``python studies/contact_law.py``: 20080 steps +
     11066 rejections, 53 s, against 6032 + 152, 12 s with "wca-c2"; free ends within
     1.5e-5 L; docs/model.md).
+
+    ``self_contact = true`` adds the same law between non-neighbouring *segments* of the
+    filament (:mod:`flagwrap.interactions.self_contact`), so that folded or wrapped parts
+    cannot pass through each other; ``self_range`` (units of ``a``: the repulsion starts
+    ``self_range a`` before the surfaces touch) and ``self_strength`` (units of ``A/b``) default
+    to ``range`` and ``strength``. Off by default: the paper's rig has none, and results stored
+    before it existed keep their keys.
     """
 
     range: float = 1.0
     strength: float = 1.0
     potential: str = "wca-c2"
+    self_contact: bool = False
+    self_range: float | None = None
+    self_strength: float | None = None
 
     def __post_init__(self):
         _positive("contact.range", self.range, "(units of a)")
         _positive("contact.strength", self.strength, "(units of A/b)")
         if self.potential not in ("wca-c2", "wca"):
             raise UserInputError(f"contact.potential must be 'wca-c2' or 'wca', got {self.potential!r}")
+        if not isinstance(self.self_contact, (bool, np.bool_)):
+            raise UserInputError(f"contact.self_contact must be true or false, got {self.self_contact!r}")
+        for k in ("self_range", "self_strength"):
+            if getattr(self, k) is not None:
+                if not self.self_contact:
+                    raise UserInputError(f"contact.{k} needs contact.self_contact = true")
+                _positive(f"contact.{k}", getattr(self, k), "(units of a)" if k == "self_range" else "(units of A/b)")
+
+    @property
+    def resolved_self_range(self) -> float:
+        return self.range if self.self_range is None else float(self.self_range)
+
+    @property
+    def resolved_self_strength(self) -> float:
+        return self.strength if self.self_strength is None else float(self.self_strength)
 
 
 @dataclass(frozen=True)
@@ -576,6 +659,7 @@ class Config:
     numerics: Numerics = field(default_factory=Numerics)
     clamp: Clamp = field(default_factory=Clamp)
     initial: Initial = field(default_factory=Initial)
+    joint: Joint = field(default_factory=Joint)
     name: str = "run"
 
     def __post_init__(self):
@@ -588,6 +672,7 @@ class Config:
             ("numerics", Numerics),
             ("clamp", Clamp),
             ("initial", Initial),
+            ("joint", Joint),
         ):
             if not isinstance(getattr(self, attr), cls):
                 raise UserInputError(f"config.{attr} must be a {cls.__name__}")
@@ -622,6 +707,18 @@ class Config:
                 f"initial helix self-overlaps: two non-neighbouring beads are {dmin:g} m apart, "
                 f"less than 2 a = {2 * fil.cross_section_radius:g} m (increase pitch or reduce a)"
             )
+        if self.joint.kind == "hook" and not self.joint.hook_length < fil.length:
+            raise UserInputError(f"joint.hook_length = {self.joint.hook_length:g} m must be shorter "
+                                 f"than the filament (filament.length = {fil.length:g} m)")
+        if self.contact.self_contact:
+            from flagwrap.interactions.self_contact import max_self_range
+
+            rmax = max_self_range(self)
+            if not self.contact.resolved_self_range < rmax:
+                raise UserInputError(
+                    f"contact.self_range = {self.contact.resolved_self_range:g} (units of a) puts "
+                    "the stress-free filament in contact with itself (non-neighbouring segments "
+                    f"closer than its cut-off a (2 + self_range)); allowed: self_range < {rmax:.3g}")
         # derived scales must be finite and positive (extreme inputs can overflow or underflow)
         derived = {}
         for what in ("bending_modulus", "twist_modulus", "omega", "machin", "reynolds"):
@@ -721,8 +818,13 @@ class Config:
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)
         if for_hash:
-            if self.initial.is_default:  # added after results were stored: default keeps keys
+            # added after results were stored: their defaults keep the keys
+            if self.initial.is_default:
                 d.pop("initial", None)
+            if self.joint.is_default:
+                d.pop("joint", None)
+            if not self.contact.self_contact:
+                d["contact"].pop("self_contact", None)
             for k, v in Numerics.HASH_OMIT_DEFAULTS.items():
                 if d["numerics"].get(k) == v:
                     d["numerics"].pop(k)

@@ -72,7 +72,7 @@ def estimate(config) -> Estimate:
     turns = total_turns(config)
     n_saves = turns / num.save_every + 2.0
     frame = 8 * (3 * N + 3 * (N - 1) + (N - 1) + 8)
-    from flagwrap.motor.clamp import AxialClamp
+    from flagwrap.joints.clamp import AxialClamp
     from flagwrap.system.layout import DofLayout
 
     # free coordinates (Estimate.unknowns): the layout RodSystem builds, 4 N - 7 with the clamp

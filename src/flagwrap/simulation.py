@@ -37,7 +37,8 @@ from flagwrap.model import RodSystem
 TWO_PI = 2.0 * math.pi
 # the per-frame records of a Trajectory, in the order Simulation._record computes them
 _RECORDS = ("t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
-            "contact_energy", "min_distance", "max_strain")
+            "contact_energy", "min_distance", "max_strain", "interaction_energy", "hook_angle",
+            "hook_torque", "hook_twist_torque")
 
 
 @dataclass
@@ -56,6 +57,10 @@ class Trajectory:
     contact_energy: list = field(default_factory=list)
     min_distance: list = field(default_factory=list)
     max_strain: list = field(default_factory=list)
+    interaction_energy: list = field(default_factory=list)
+    hook_angle: list = field(default_factory=list)
+    hook_torque: list = field(default_factory=list)
+    hook_twist_torque: list = field(default_factory=list)
     status: str = "running"
     message: str = ""
     n_steps: int = 0
@@ -108,10 +113,11 @@ class Simulation:
         # everything computed before anything is appended: an interrupt in between must not
         # leave the records with different lengths
         phi = y[s.i_phi]
+        hook = s.joint.observables(info.x, info.theta, m1, m2, info.frames, s.rest)
         row = (t, info.x.copy(), info.theta.copy(), m1, phi, omega,
                s.motor_torque(info, phi, omega), info.elastic_energy, info.contact_energy,
                float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf,
-               self._strain(info))
+               self._strain(info), info.interaction_energy) + hook
         for name, value in zip(_RECORDS, row):
             getattr(traj, name).append(value)
 

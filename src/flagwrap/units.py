@@ -138,3 +138,9 @@ class Scales:
 
     def from_torque(self, n):
         return n * self.torque
+
+
+def hook_spring(hook_modulus: float, hook_length: float, bending: float, length: float) -> float:
+    """A lumped joint's spring ``K_h / l_h`` (bending ``A_h`` or twist ``C_h`` over the hook
+    length) in the core torque unit ``A / L``: ``K_h L / (A l_h)`` (docs/hook.md)."""
+    return hook_modulus * length / (bending * hook_length)

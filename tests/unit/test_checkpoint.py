@@ -182,3 +182,10 @@ def test_resume_without_checkpoint_is_a_clean_error(tmp_path):
     cfgp = tmp_path / "t.toml"
     cfgp.write_text(tiny_toml())
     assert main(["run", str(cfgp), "--quiet", "--resume", "-o", str(tmp_path / "o.nc")]) == 2
+
+
+def test_checkpoint_records_are_the_trajectory_records():
+    from flagwrap.io.checkpoint import RECORD_NAMES
+    from flagwrap.simulation import _RECORDS
+
+    assert RECORD_NAMES == _RECORDS

@@ -108,7 +108,7 @@ def test_forces_covariant_under_rigid_rotation():
     x, th, phi = s.unpack(y)
     # rotate the whole system, clamp included
     from flagwrap.elasticity.rod import Frames
-    from flagwrap.motor.clamp import AxialClamp
+    from flagwrap.joints.clamp import AxialClamp
 
     sr = RodSystem(cfg, x0=s.x0 @ Rm.T)
     sr.clamp = AxialClamp(s.x0 @ Rm.T, s.theta0, axis=Rm @ np.array([0, 0, -1.0]))

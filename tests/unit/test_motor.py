@@ -56,7 +56,7 @@ def test_ccw_keeps_left_handed_helix_and_cw_unwinds_it_near_motor():
 def test_clamp_positions_are_rotations_about_the_motor_axis(phi, axis):
     """The precomputed Rodrigues split equals the rotation matrix (an independent formula)."""
     from flagwrap.geometry.frames import rotation_matrix
-    from flagwrap.motor.clamp import AxialClamp
+    from flagwrap.joints.clamp import AxialClamp
 
     x0 = np.array([[0.1, -0.2, 0.3], [0.4, 0.5, -0.6], [1.0, 1.0, 1.0]])
     clamp = AxialClamp(x0, np.zeros(2), axis=axis)

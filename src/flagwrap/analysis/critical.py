@@ -146,11 +146,10 @@ def simulate_until_buckled(cfg, stop_after: float | None = 2.0, chunk_turns: flo
     from threadpoolctl import threadpool_limits
 
     from flagwrap.analysis.buckling import WaitingTime
+    from flagwrap.simulation import _RECORDS as keys
     from flagwrap.simulation import TWO_PI, Simulation
 
     waiting = waiting if waiting is not None else WaitingTime()
-    keys = ("t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
-            "contact_energy", "min_distance", "max_strain")
     with threadpool_limits(limits=cfg.numerics.threads):
         sim = Simulation(cfg)
         sched = sim.system.schedule

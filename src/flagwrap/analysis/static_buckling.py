@@ -114,7 +114,8 @@ def _stiffness(system, y, base):
 
 def _potential(system, info) -> float:
     """Elastic + contact energy + the potential of the (constant) gravity force, core units."""
-    return info.elastic_energy + info.contact_energy - float(np.sum(system.gravity * info.x))
+    return (info.elastic_energy + info.contact_energy + info.interaction_energy
+            - float(np.sum(system.gravity * info.x)))
 
 
 def equilibrium(system, y0=None, base=None, tol: float = 1e-8, xtol: float = 1e-11,

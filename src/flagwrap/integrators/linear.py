@@ -125,10 +125,14 @@ class KrylovW:
         self.maxiter = maxiter
         self.inv_scale = None if err_scale is None else 1.0 / np.asarray(err_scale, float)
         self.kappa = kappa
-        rows, cols, vals = system.force_jacobian_coo(y, base, G0)
-        self.J = sp.csr_matrix((vals, (rows, cols)), shape=(system.ny, system.ny))
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0, nonlocal_terms=False)
         self.P = BandedW(system, y, base, G0, gamma_h, width=width,
                          triplets=(rows, cols, vals))
+        # the product sees every term; the banded preconditioner the chain-local ones
+        for r, c, v in system.interaction_jacobian_coo(y, "nonlocal"):
+            rows, cols, vals = (np.concatenate([rows, r]), np.concatenate([cols, c]),
+                                np.concatenate([vals, v]))
+        self.J = sp.csr_matrix((vals, (rows, cols)), shape=(system.ny, system.ny))
         n = system.ny
         self.Z = np.empty((self.max_vectors, n))
         self.C = np.empty((self.max_vectors, n))
@@ -269,7 +273,7 @@ class BandedW:
 
         from flagwrap._system_kernels import band_from_triplets
 
-        rows, cols, vals = triplets or system.force_jacobian_coo(y, base, G0)
+        rows, cols, vals = triplets or system.force_jacobian_coo(y, base, G0, nonlocal_terms=False)
         # pairs farther apart than the chain is long do not exist: clamp (short chains)
         width = min(int(width), max(system.nb - 1, 0)) if system.mobility.long_range else 0
         perm, inv, kl, ku = _band_structure(system, rows, cols, width)

@@ -1,2 +1,2 @@
-"""Interactions between the parts of the system (issue 15's layout): so far the filament's
-self-contact (:mod:`flagwrap.interactions.self_contact`)."""
+"""Interactions of the system (the interface: :mod:`flagwrap.interactions.base`): so far the
+filament's self-contact (:mod:`flagwrap.interactions.self_contact`)."""

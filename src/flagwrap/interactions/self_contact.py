@@ -15,12 +15,17 @@ distance) ``dd/dx_i = (1 - s) n``, ``dd/dx_{i+1} = s n``, ``dd/dx_j = -(1 - t) n
 ``dd/dx_{j+1} = -t n`` with ``n = (p - q)/d``: the exact gradient wherever the closest points
 are unique (tests/unit/test_self_contact.py checks it against finite differences).
 
-Pairs closer than ``exclude`` bonds along the contour are skipped: neighbouring bonds always
-lie within the cut-off of each other on a smooth filament. :func:`count_crossings` counts the
+Pairs whose contour gap (from the end of one segment to the start of the other) is shorter
+than the cut-off plus the longest rest bond are skipped: neighbouring bonds always lie within
+the cut-off of each other on a smooth filament. On a uniform chain this skips
+``j - i <= exclude = ceil(d_c / b) + 1``; on a chain with short bonds (a resolved hook) it
+skips by contour length, not by bond count. :func:`self_contact_hessian` gives the pair
+Hessians (central differences of the exact pair gradient) for the implicit integrators. :func:`count_crossings` counts the
 segment pairs that pass through each other between saved frames of a run (the check that the
 repulsion works; docs/model.md).
 
-Not yet part of the simulated system: issue 15's composable system adds it as an interaction.
+In the simulated system it is the interaction :class:`SelfContactInteraction`
+(``contact.self_contact = true``).
 """
 
 from __future__ import annotations
@@ -71,10 +76,10 @@ def segment_closest(p0, p1, q0, q1):
 
 
 @nb.njit(cache=True)
-def self_contact_energy_grad(x, cut, sigma, eps, c2, exclude, grad):
+def self_contact_energy_grad(x, cut, sigma, eps, c2, first, grad):
     """Energy of the segment-pair repulsion of the chain ``x`` (N, 3); adds ``dU/dx`` to
-    ``grad``. Pairs ``(i, j)`` with ``j - i <= exclude`` are skipped. Returns
-    ``(energy, smallest segment distance among the pairs considered)``."""
+    ``grad``. Segment ``i`` meets segments ``j >= first[i]`` only (its contour neighbours are
+    skipped). Returns ``(energy, smallest segment distance among the pairs considered)``."""
     n = x.shape[0] - 1
     k2 = c2 * 72.0 * eps / (cut * cut)
     E = 0.0
@@ -86,7 +91,7 @@ def self_contact_energy_grad(x, cut, sigma, eps, c2, exclude, grad):
         ciz = 0.5 * (x[i, 2] + x[i + 1, 2])
         hi = 0.5 * math.sqrt((x[i + 1, 0] - x[i, 0]) ** 2 + (x[i + 1, 1] - x[i, 1]) ** 2
                              + (x[i + 1, 2] - x[i, 2]) ** 2)
-        for j in range(i + exclude + 1, n):
+        for j in range(first[i], n):
             cjx = 0.5 * (x[j, 0] + x[j + 1, 0])
             cjy = 0.5 * (x[j, 1] + x[j + 1, 1])
             cjz = 0.5 * (x[j, 2] + x[j + 1, 2])
@@ -128,7 +133,8 @@ class SelfContact:
     radius : float
         filament cross-section radius ``a`` [L].
     bond : float
-        bond length ``b`` [L] (sets the contour exclusion).
+        bond length ``b`` [L] of a uniform chain (sets the contour exclusion), or ignored when
+        ``rest_lengths`` (N-1,) are given.
     range : float
         the repulsion starts ``range * a`` before the surfaces touch: cut-off ``a (2 + range)``.
     strength : float
@@ -138,20 +144,175 @@ class SelfContact:
     """
 
     def __init__(self, radius: float, bond: float, range: float = 1.0, strength: float = 1.0,
-                 c2: float = 1.0):
+                 c2: float = 1.0, rest_lengths=None):
         if not (radius > 0 and bond > 0 and range > 0 and strength > 0):
             raise ValueError("SelfContact: radius, bond, range and strength must be > 0")
         self.cut = radius * (2.0 + range)
         self.sigma = self.cut / 2.0 ** (1.0 / 6.0)
         self.eps = float(strength)
         self.c2 = float(c2)
+        self.rest_lengths = None if rest_lengths is None else np.asarray(rest_lengths, float)
+        self.bond = float(bond)
         # bonds whose contour distance is within the cut-off are neighbours, not contacts
         self.exclude = int(math.ceil(self.cut / bond)) + 1
+        self._first_n = None
+
+    def first(self, n_segments: int) -> np.ndarray:
+        """``first[i]``: the first segment that segment ``i`` can touch (module docstring)."""
+        if self._first_n is not None and self._first_n[0] == n_segments:
+            return self._first_n[1]
+        if self.rest_lengths is None:
+            first = np.arange(n_segments, dtype=np.int64) + self.exclude + 1
+        else:
+            l0 = self.rest_lengths
+            arc = np.concatenate([[0.0], np.cumsum(l0)])
+            need = self.cut + l0.max() - 1e-9 * l0.max()
+            # first j with arc[j] - arc[i + 1] >= need
+            first = np.searchsorted(arc, arc[1:] + need, side="left").astype(np.int64)
+        first = np.minimum(first, n_segments)
+        self._first_n = (n_segments, first)
+        return first
+
+    @property
+    def exclude(self) -> int:
+        return self._exclude
+
+    @exclude.setter
+    def exclude(self, value: int):
+        self._exclude = int(value)
+        self._first_n = None
 
     def energy_grad(self, x: np.ndarray, grad: np.ndarray) -> tuple[float, float]:
         """``(energy, smallest distance)``; adds ``dU/dx`` to ``grad`` (N, 3)."""
-        return self_contact_energy_grad(np.ascontiguousarray(x, float), self.cut, self.sigma,
-                                        self.eps, self.c2, self.exclude, grad)
+        x = np.ascontiguousarray(x, float)
+        return self_contact_energy_grad(x, self.cut, self.sigma, self.eps, self.c2,
+                                        self.first(len(x) - 1), grad)
+
+    def hessian_coo(self, x: np.ndarray):
+        """``d^2 U / dx^2`` as COO triplets over bead coordinates ``3 i + c`` (active pairs only)."""
+        x = np.ascontiguousarray(x, float)
+        return self_contact_hessian(x, self.cut, self.sigma, self.eps, self.c2,
+                                    self.first(len(x) - 1))
+
+
+@nb.njit(cache=True)
+def _pair_grad(P, cut, sigma, eps, k2, out):
+    """Gradient (12,) of one pair's energy w.r.t. ``P`` = (x_i, x_i+1, x_j, x_j+1) (12,)."""
+    s, t, dx, dy, dz = segment_closest(P[0:3], P[3:6], P[6:9], P[9:12])
+    d = math.sqrt(dx * dx + dy * dy + dz * dz)
+    out[:] = 0.0
+    if d >= cut or d <= 0.0:
+        return
+    s6 = (sigma / d) ** 6
+    dU = (4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / d - k2 * (d - cut)) / d
+    w = (1.0 - s, s, -(1.0 - t), -t)
+    for k in range(4):
+        out[3 * k] = w[k] * dU * dx
+        out[3 * k + 1] = w[k] * dU * dy
+        out[3 * k + 2] = w[k] * dU * dz
+
+
+@nb.njit(cache=True)
+def self_contact_hessian(x, cut, sigma, eps, c2, first):
+    """Hessian triplets of the pairs within the cut-off: central differences (step
+    ``1e-6 d_c``) of the exact pair gradient, 144 entries per active pair."""
+    n = x.shape[0] - 1
+    k2 = c2 * 72.0 * eps / (cut * cut)
+    pairs_i = []
+    pairs_j = []
+    for i in range(n):
+        for j in range(first[i], n):
+            s, t, dx, dy, dz = segment_closest(x[i], x[i + 1], x[j], x[j + 1])
+            if dx * dx + dy * dy + dz * dz < cut * cut:
+                pairs_i.append(i)
+                pairs_j.append(j)
+    m = len(pairs_i)
+    rows = np.empty(144 * m, np.int64)
+    cols = np.empty(144 * m, np.int64)
+    vals = np.empty(144 * m)
+    P = np.empty(12)
+    gp = np.empty(12)
+    gm = np.empty(12)
+    h = 1e-6 * cut
+    q = 0
+    for p in range(m):
+        i = pairs_i[p]
+        j = pairs_j[p]
+        beads = (i, i + 1, j, j + 1)
+        for k in range(4):
+            for c in range(3):
+                P[3 * k + c] = x[beads[k], c]
+        for col in range(12):
+            v = P[col]
+            P[col] = v + h
+            _pair_grad(P, cut, sigma, eps, k2, gp)
+            P[col] = v - h
+            _pair_grad(P, cut, sigma, eps, k2, gm)
+            P[col] = v
+            for row in range(12):
+                rows[q] = 3 * beads[row // 3] + row % 3
+                cols[q] = 3 * beads[col // 3] + col % 3
+                vals[q] = (gp[row] - gm[row]) / (2.0 * h)
+                q += 1
+    return rows, cols, vals
+
+
+class SelfContactInteraction:
+    """:class:`SelfContact` as an interaction of the system (:mod:`flagwrap.interactions.base`)."""
+
+    name = "self_contact"
+    nonlocal_hessian = True  # pairs far apart along the chain: not in banded solvers' W
+
+    def __init__(self, contact: SelfContact):
+        self.contact = contact
+        self.min_distance = np.inf
+
+    def energy_grad(self, x, theta, grad_x, grad_theta) -> float:
+        E, dmin = self.contact.energy_grad(x, grad_x)
+        self.min_distance = dmin
+        return E
+
+    def hessian_coo(self, x, theta):
+        return self.contact.hessian_coo(x)
+
+
+def max_self_range(config) -> float:
+    """The largest ``contact.self_range`` [a] that leaves the stress-free filament (with its
+    joint) out of contact with itself; ``inf`` for a shape with no non-neighbouring segments
+    close enough to matter."""
+    from flagwrap.elasticity.rod import initial_frames  # noqa: F401  (light import)
+    from flagwrap.geometry.helix import filament_positions
+    from flagwrap.joints import make_joint
+
+    fil = config.filament
+    L = fil.length
+    x0 = filament_positions(fil, config.clamp) / L
+    _, x, _ = make_joint(config, x0, np.zeros(len(x0) - 1))
+    x = np.ascontiguousarray(x)
+    l0 = np.linalg.norm(np.diff(x, axis=0), axis=1)
+    a = fil.cross_section_radius / L
+
+    def touches(r):
+        sc = SelfContact(a, fil.bond_length / L, range=r, rest_lengths=l0)
+        return sc.energy_grad(x, np.zeros_like(x))[0] > 0.0
+
+    if touches(1e-9):
+        return 0.0
+    # grow the range until the stress-free shape touches itself, or until the contour
+    # exclusion (which grows with the cut-off) leaves no pair to touch
+    lo, hi = 0.0, 0.01
+    while not touches(hi):
+        sc = SelfContact(a, fil.bond_length / L, range=hi, rest_lengths=l0)
+        if sc.first(len(x) - 1)[0] >= len(x) - 1:
+            return math.inf
+        lo, hi = hi, 2.0 * hi
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        if touches(mid):
+            hi = mid
+        else:
+            lo = mid
+    return lo
 
 
 @nb.njit(cache=True)

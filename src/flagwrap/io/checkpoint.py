@@ -36,8 +36,11 @@ from flagwrap.io.atomic import atomic_write
 
 CHECKPOINT_FORMAT = 1
 _MAGIC = "flagwrap checkpoint"
+#: the per-frame records of a trajectory (flagwrap.simulation._RECORDS, repeated here so that
+#: reading a checkpoint does not import the simulator; tests/unit/test_checkpoint.py checks)
 RECORD_NAMES = ("t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
-                "contact_energy", "min_distance", "max_strain")
+                "contact_energy", "min_distance", "max_strain", "interaction_energy",
+                "hook_angle", "hook_torque", "hook_twist_torque")
 _SCALARS = {"t": float, "t_end": float, "h": float, "next_save": float, "n_steps": int,
             "n_rejected": int, "wall_time": float}
 

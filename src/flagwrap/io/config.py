@@ -22,8 +22,8 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from flagwrap.errors import UserInputError
-from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Fluid, Initial, Motor,
-                             Numerics, Phase)
+from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Fluid, Initial, Joint,
+                             Motor, Numerics, Phase)
 
 _SECTIONS = {
     "filament": Filament,
@@ -34,6 +34,7 @@ _SECTIONS = {
     "numerics": Numerics,
     "clamp": Clamp,
     "initial": Initial,
+    "joint": Joint,
 }
 _LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "micron": 1e-6, "nm": 1e-9}
 _PRESSURE = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
@@ -43,6 +44,7 @@ _LENGTH_KEYS = {
     "filament": ("length", "helix_radius", "pitch", "cross_section_radius", "hydrodynamic_radius"),
     "body": ("radius", "cylinder_length"),
     "initial": ("perturbation",),
+    "joint": ("hook_length",),
 }
 
 
@@ -181,8 +183,9 @@ def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
     ``for_hash``: the text result keys are computed from (see ``Config.to_dict``)."""
     d = cfg.to_dict(for_hash=for_hash)
     lines = [f"name = {_toml_value(d.pop('name'))}", ""]
-    for section in ("filament", "fluid", "body", "motor", "clamp", "contact", "numerics", "initial"):
-        if section == "initial" and section not in d:
+    for section in ("filament", "fluid", "body", "motor", "clamp", "contact", "numerics", "initial",
+                    "joint"):
+        if section in ("initial", "joint") and section not in d:
             continue  # omitted from the hashed text while it holds its defaults
         table = d.get(section, {})
         lines.append(f"[{section}]")

@@ -19,6 +19,11 @@ elastic_energy         (time)                 [J]
 contact_energy         (time)                 [J]
 min_body_distance      (time)                 bead centre to body surface [m]
 max_bond_strain        (time)                 max |l/l0 - 1|
+interaction_energy     (time)                 energy of the interactions (self-contact) [J]
+hook_angle             (time)                 angle between the motor's bond and the first
+                                              bond of the filament proper [rad]
+hook_torque            (time)                 bending torque at the joint's vertex [N m]
+hook_twist_torque      (time)                 twist torque at the joint's vertex [N m]
 =====================  =====================  ==============================================
 
 Global attributes: ``flagwrap_version``, ``format_version``, ``config_toml`` (the full input,
@@ -71,6 +76,10 @@ def trajectory_dataset(traj):
             "contact_energy": ("time", a["contact_energy"] * sc.energy, {"units": "J"}),
             "min_body_distance": ("time", a["min_distance"] * L, {"units": "m"}),
             "max_bond_strain": ("time", a["max_strain"], {"units": "1"}),
+            "interaction_energy": ("time", a["interaction_energy"] * sc.energy, {"units": "J"}),
+            "hook_angle": ("time", a["hook_angle"], {"units": "rad"}),
+            "hook_torque": ("time", a["hook_torque"] * sc.torque, {"units": "N m"}),
+            "hook_twist_torque": ("time", a["hook_twist_torque"] * sc.torque, {"units": "N m"}),
         },
         coords={"time": ("time", t_si, {"units": "s"}), "xyz": ["x", "y", "z"]},
         attrs={
@@ -100,6 +109,7 @@ def trajectory_dataset(traj):
             "wall_time_s": traj.wall_time,
             "integrator": cfg.numerics.integrator,
             "hydrodynamics": int(cfg.numerics.hydrodynamics),
+            "joint": cfg.joint.kind,
             "conventions": "body axis +z, clamp at origin, filament hangs toward -z; "
                            "rotation sign: positive = CCW seen from the free end",
         },

@@ -1,6 +1,7 @@
-"""Motor protocols (angular velocity against time) and the clamp boundary condition."""
+"""Motor protocols (angular velocity against time). The joints the motor drives (the clamp,
+the hook) live in :mod:`flagwrap.joints`; ``AxialClamp`` is re-exported here for old imports."""
 
-from flagwrap.motor.clamp import AxialClamp
+from flagwrap.joints.clamp import AxialClamp
 from flagwrap.motor.protocol import Schedule
 
 __all__ = ["Schedule", "AxialClamp"]

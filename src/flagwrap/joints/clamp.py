@@ -1,8 +1,11 @@
-"""Boundary condition at the driven end.
+"""The clamp: the paper's boundary condition at the driven end.
 
 :class:`AxialClamp` holds the first bond (beads 0 and 1) and turns it, with its material frame,
-about the body axis by the motor angle ``phi``. The hook of a real bacterium (a universal joint)
-would be another class with the same methods.
+about the body axis by the motor angle ``phi``. Vertex 1, where the filament leaves the
+clamped bond, bends and twists with the filament's own stiffness (``A/b``, ``C/b``). It is
+the base of the other joints (:mod:`flagwrap.joints.hook`), which keep its kinematics and
+change what happens at and after vertex 1. The interface every joint has is
+:class:`flagwrap.joints.base.Joint`.
 """
 
 from __future__ import annotations
@@ -11,9 +14,10 @@ import math
 
 import numpy as np
 
+from flagwrap.joints.base import Joint
 
 
-class AxialClamp:
+class AxialClamp(Joint):
     """Clamped first bond, rotated about ``axis`` (unit, through the origin) by ``phi``.
 
     Attributes

@@ -1,0 +1,97 @@
+"""The flagellar hook: a short elastic joint between the motor and the filament.
+
+The paper (Discussion): "the hook enables a bacterium to wrap its filament around its cell body
+without forming any localized bend". Two representations of one hook of length ``l_h``,
+bending stiffness ``A_h`` and twist stiffness ``C_h`` (core units: ``A = 1``, lengths in ``L``):
+
+* :class:`LumpedHook` (``joint.hook_segments = 0``): the clamp's kinematics (the motor holds
+  the first bond), with vertex 1, between the motor axis and the first free bond, a bending
+  spring ``A_h/l_h`` and a twist spring ``C_h/l_h`` instead of the filament's ``A/b``,
+  ``C/b``: the discrete-rod energy ``A_h/(2 l_h) |kappa - kappa_bar|^2 +
+  C_h/(2 l_h) (m - m_bar)^2`` of a rod of length ``l_h`` bent uniformly (Bergou et al. 2008).
+  A hook with ``A_h/l_h = A/b`` *is* the clamp. The rest angle is the initial shape's at the
+  vertex (the kink to the helix for ``clamp.lead = "kink"``), so the initial state is
+  stress-free.
+* :class:`ResolvedHook` (``hook_segments = n >= 2``): ``n`` bonds of length ``l_h/n`` along the
+  motor axis inserted between the motor's bond and the filament, which keeps its own beads (the
+  contour grows by ``l_h``). The hook's vertices carry the compliance ``l_h/A_h`` in total:
+  ``l_h/(2n)/A_h`` at each end, ``l_h/(n A_h)`` between; the junction to the filament adds the
+  filament's half bond ``b/(2A)``. The hook is straight at rest; the kink to the helix sits at
+  the junction.
+
+Both agree where both apply (``l_h << L``): tests/unit/test_hook.py compares their torque
+balance with the analytic one. The universal-joint limit is ``A_h -> 0`` with the twist kept.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from flagwrap.joints.clamp import AxialClamp
+
+
+class LumpedHook(AxialClamp):
+    """The clamp's kinematics with vertex 1 a spring ``k_bend = A_h/l_h``, ``k_twist = C_h/l_h``
+    (core units ``A/L``)."""
+
+    kind = "hook"
+
+    def __init__(self, x0, theta0, k_bend: float, k_twist: float, axis=(0.0, 0.0, -1.0)):
+        super().__init__(x0, theta0, axis)
+        if not (k_bend > 0 and k_twist > 0):
+            raise ValueError("LumpedHook: k_bend and k_twist must be > 0")
+        self.k_bend = float(k_bend)
+        self.k_twist = float(k_twist)
+
+    def rest(self, rest):
+        return rest.with_vertex(1, cbend=self.k_bend, ctwist=self.k_twist)
+
+
+def insert_hook(x0: np.ndarray, theta0: np.ndarray, length: float, segments: int):
+    """``x0`` with ``segments`` bonds of ``length/segments`` inserted after bead 1, along the
+    motor's bond; the beads beyond move by ``length`` along it (their shape is unchanged)."""
+    t0 = x0[1] - x0[0]
+    t0 = t0 / np.linalg.norm(t0)
+    s = length / segments * np.arange(1, segments + 1)
+    hook = x0[1] + s[:, None] * t0
+    x = np.concatenate([x0[:2], hook, x0[2:] + length * t0])
+    theta = np.concatenate([theta0[:1], np.full(segments, theta0[0]), theta0[1:]])
+    return x, theta
+
+
+class ResolvedHook(AxialClamp):
+    """A hook of ``segments`` short bonds after the motor's bond (see the module docstring).
+
+    ``bending``, ``twist``: ``A_h``, ``C_h`` [A]; ``length``: ``l_h`` [L]; ``rod_bending``,
+    ``rod_twist``: the filament's ``A``, ``C`` [A]; ``bond``: its bond ``b`` [L].
+    """
+
+    kind = "hook"
+
+    def __init__(self, x0, theta0, length, segments, bending, twist, rod_bending, rod_twist,
+                 bond, axis=(0.0, 0.0, -1.0)):
+        super().__init__(x0, theta0, axis)
+        if not (length > 0 and segments >= 2 and bending > 0 and twist > 0):
+            raise ValueError("ResolvedHook: length, bending, twist > 0 and segments >= 2 needed")
+        self.length, self.segments = float(length), int(segments)
+        self.bending, self.twist = float(bending), float(twist)
+        self.rod_bending, self.rod_twist, self.bond = float(rod_bending), float(rod_twist), float(bond)
+        self.exit_bond = self.segments + 1
+
+    def _compliances(self, modulus, rod_modulus):
+        """Per-vertex ``l_i/K_i`` of vertices 1..n+1 (their sum over the hook is ``l_h/K_h``)."""
+        n, lh = self.segments, self.length
+        c = np.full(n + 1, lh / (n * modulus))
+        c[0] = c[-1] = lh / (2 * n * modulus)
+        c[-1] += 0.5 * self.bond / rod_modulus
+        return c
+
+    def rest(self, rest):
+        n = self.segments
+        cb = rest.cbend.copy()
+        ct = rest.ctwist.copy()
+        cb[1:n + 2] = 1.0 / self._compliances(self.bending, self.rod_bending)
+        ct[1:n + 2] = 1.0 / self._compliances(self.twist, self.rod_twist)
+        return dataclasses.replace(rest, cbend=cb, ctwist=ct)
