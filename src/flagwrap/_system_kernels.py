@@ -47,13 +47,13 @@ def unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta):
 
 @nb.njit(cache=True)
 def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
-                       base_t, base_d1, base_rt, l0, cbend, ctwist, kbar, mbar, ks,
+                       base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
                        has_body, Rc, H, sigma, eps, c2, gravity,
                        G, x, theta, gx, gth, d1_out, rt_out, dist):
     """Fill ``G`` (ny,) and the work arrays; return (elastic energy, contact energy)."""
     N = x.shape[0]
     unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta)
-    E = energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, kbar, mbar, ks,
+    E = energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
                     gx, gth, d1_out, rt_out)
     Ec = 0.0
     if has_body:
@@ -79,7 +79,7 @@ def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
 @nb.njit(cache=True)
 def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
                     nc, ec, x_ref, axis, theta_ref, twist_rate,
-                    base_t, base_d1, base_rt, l0, cbend, ctwist, kbar, mbar, ks,
+                    base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
                     has_body, Rc, H, sigma, eps, c2, gravity):
     """``J = dG/dy`` as COO triplets (duplicates to be summed), O(N) time and memory.
 
@@ -108,14 +108,14 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
     cols = np.empty(n_tot, np.int64)
     vals = np.empty(n_tot)
     generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
-                       base_rt, l0, cbend, ctwist, kbar, mbar, 0.0, has_body, Rc, H, sigma,
+                       base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, 0.0, has_body, Rc, H, sigma,
                        eps, c2, gravity, Gs, x, theta, gx, gth, d1, rt, dist)
     n_groups = g_ptr.shape[0] - 1
     for g in range(n_groups):
         for q in range(g_ptr[g], g_ptr[g + 1]):
             yp[g_cols[q]] += delta
         generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
-                           base_rt, l0, cbend, ctwist, kbar, mbar, 0.0, has_body, Rc, H, sigma,
+                           base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, 0.0, has_body, Rc, H, sigma,
                            eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist)
         for q in range(e_ptr[g], e_ptr[g + 1]):
             r = e_rows[q]
@@ -152,7 +152,7 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
                         k += 1
     yp[ny - 1] += delta
     generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
-                       base_rt, l0, cbend, ctwist, kbar, mbar, ks, has_body, Rc, H, sigma,
+                       base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks, has_body, Rc, H, sigma,
                        eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist)
     for r in range(ny):
         v = (G[r] - G0[r]) / delta

@@ -182,7 +182,7 @@ class RodSystem:
         r, c, b = self.rest, self.clamp, self.body
         has_body = not isinstance(b, NoBody)
         return (self.nc, self.ec, c.x_ref, c.axis, c.theta_ref, c.twist_rate,
-                base.t, base.d1, base.rt, r.l0, r.cbend, r.ctwist, r.kbar, r.mbar,
+                base.t, base.d1, base.rt, r.l0, r.cbend, r.ctwist, r.angle_law, r.kbar, r.mbar,
                 r.stretch, has_body, b.radius if has_body else 0.0,
                 b.length if has_body else 0.0, b.sigma if has_body else 0.0,
                 b.strength if has_body else 0.0, b.c2 if has_body else 0.0, self.gravity)

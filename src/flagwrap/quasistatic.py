@@ -164,7 +164,7 @@ class _Energy:
         r, b = self.rest, self.base
         x = np.ascontiguousarray(q[:, :3])
         th = np.ascontiguousarray(q[:-1, 3])
-        E = K.energy_grad(x, th, b.t, b.d1, b.rt, r.l0, r.cbend, r.ctwist, r.kbar, r.mbar,
+        E = K.energy_grad(x, th, b.t, b.d1, b.rt, r.l0, r.cbend, r.ctwist, r.angle_law, r.kbar, r.mbar,
                           r.stretch, self.gx, self.gth, self.d1, self.rt)
         if gout is not None:
             gout[:, :3] = self.gx

@@ -21,7 +21,13 @@ Energy (dimensionless, A = 1 in the core units)::
 
 with per-vertex coefficients ``cb_i = A_i / l_i`` and ``ct_i = C_i / l_i`` (Voronoi length
 ``l_i = (l0_{i-1} + l0_i)/2``; a uniform rod has ``A_i = A``, ``C_i = C``). A joint is a vertex
-with other coefficients: the lumped hook (:mod:`flagwrap.joints.hook`) sets ``cb_1 = A_h/l_h``. Rest values are those of the initial helix,
+with other coefficients: the lumped hook (:mod:`flagwrap.joints.hook`) sets ``cb_1 = A_h/l_h``.
+
+Discrete curvature ``|kb| = 2 tan(psi/2)`` of the turning angle ``psi`` is right for the small
+angles between bonds of a smooth rod, but a lumped joint bends through large angles, where
+``cb/2 |kb|^2`` would stiffen without bound (by 7 % at psi = 0.46 rad, 2.5x at pi/2). At
+vertices flagged ``angle_law`` the material curvatures are scaled by ``g = psi/|kb|``, so the
+energy is ``cb/2 psi^2`` for a plane bend: that of a short rod bent uniformly through ``psi``. Rest values are those of the initial helix,
 so the stress-free helix is an exact minimum (E = 0).
 
 The gradient is exact for the energy evaluated with reference frames transported from a base
@@ -121,11 +127,13 @@ def curvatures(t, m1, m2, kb, kappa):
 
 
 @nb.njit(cache=True)
-def energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, kbar, mbar, ks,
-                grad_x, grad_th, d1_out, rt_out):
+def energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar,
+                ks, grad_x, grad_th, d1_out, rt_out):
     """Elastic energy and its gradient (dE/dx (N,3), dE/dtheta (N-1)).
 
-    ``cbend``, ``ctwist`` (N,): the vertex coefficients ``A_i/l_i``, ``C_i/l_i`` (ends unused).
+    ``cbend``, ``ctwist`` (N,): the vertex coefficients ``A_i/l_i``, ``C_i/l_i`` (ends unused);
+    ``angle_law`` (N,) bool: vertices whose curvatures measure the turning angle ``psi``
+    instead of ``2 tan(psi/2)`` (the lumped hook: module docstring).
 
     ``grad_x``, ``grad_th`` are overwritten; ``d1_out`` (N-1,3) and ``rt_out`` (N) receive the
     transported reference directors and reference twist at ``x`` (the next base).
@@ -166,12 +174,43 @@ def energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, kbar, mba
         tt2 = (ta2 + tb2) / chi
         k1 = 0.5 * (mt20 * kb0 + mt21 * kb1 + mt22 * kb2) * chi
         k2 = -0.5 * (mt10 * kb0 + mt11 * kb1 + mt12 * kb2) * chi
-        d1 = k1 - kbar[i, 0]
-        d2 = k2 - kbar[i, 1]
         cb = cbend[i]
-        E += 0.5 * cb * (d1 * d1 + d2 * d2)
         inv_a = 1.0 / ln[i - 1]
         inv_b = 1.0 / ln[i]
+        cbg = cb
+        if angle_law[i]:
+            # the turning angle psi instead of |kb| = 2 tan(psi/2): curvatures scaled by
+            # g = psi/|kb| (a short rod bent uniformly through psi stores cb psi^2 / 2)
+            q = kb0 * kb0 + kb1 * kb1 + kb2 * kb2
+            kn = math.sqrt(q)
+            if kn > 1e-4:
+                psi = 2.0 * math.atan(0.5 * kn)
+                g = psi / kn
+                dgdq = (kn / (1.0 + 0.25 * q) - psi) / (q * 2.0 * kn)
+            else:  # series (relative error < 1e-16 at kn = 1e-4)
+                g = 1.0 - q / 12.0 + q * q / 80.0
+                dgdq = -1.0 / 12.0 + q / 40.0
+            k1 *= g
+            k2 *= g
+            d1 = k1 - kbar[i, 0]
+            d2 = k2 - kbar[i, 1]
+            # chain rule through q = |kb|^2 = 4 (1 - c)/(1 + c), c = t_{i-1}.t_i
+            cq = cb * (d1 * k1 + d2 * k2) / g * dgdq * (-8.0 / (chi * chi))
+            c = chi - 1.0
+            ge[i - 1, 0] += cq * inv_a * (tb0 - c * ta0)
+            ge[i - 1, 1] += cq * inv_a * (tb1 - c * ta1)
+            ge[i - 1, 2] += cq * inv_a * (tb2 - c * ta2)
+            ge[i, 0] += cq * inv_b * (ta0 - c * tb0)
+            ge[i, 1] += cq * inv_b * (ta1 - c * tb1)
+            ge[i, 2] += cq * inv_b * (ta2 - c * tb2)
+            cbg = cb * g
+            # the DER terms below differentiate the unscaled curvatures: undo the scaling there
+            k1 /= g
+            k2 /= g
+        else:
+            d1 = k1 - kbar[i, 0]
+            d2 = k2 - kbar[i, 1]
+        E += 0.5 * cb * (d1 * d1 + d2 * d2)
         # t_i x mt2, t_{i-1} x mt2, t_i x mt1, t_{i-1} x mt1
         xb20 = tb1 * mt22 - tb2 * mt21
         xb21 = tb2 * mt20 - tb0 * mt22
@@ -187,19 +226,19 @@ def energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, kbar, mba
         xa12 = ta0 * mt11 - ta1 * mt10
         # d kappa1 / d e_{i-1} = (-k1 tt + t_i x mt2)/|e_{i-1}| ; / d e_i = (-k1 tt - t_{i-1} x mt2)/|e_i|
         # d kappa2 / d e_{i-1} = (-k2 tt - t_i x mt1)/|e_{i-1}| ; / d e_i = (-k2 tt + t_{i-1} x mt1)/|e_i|
-        ge[i - 1, 0] += cb * inv_a * (d1 * (-k1 * tt0 + xb20) + d2 * (-k2 * tt0 - xb10))
-        ge[i - 1, 1] += cb * inv_a * (d1 * (-k1 * tt1 + xb21) + d2 * (-k2 * tt1 - xb11))
-        ge[i - 1, 2] += cb * inv_a * (d1 * (-k1 * tt2 + xb22) + d2 * (-k2 * tt2 - xb12))
-        ge[i, 0] += cb * inv_b * (d1 * (-k1 * tt0 - xa20) + d2 * (-k2 * tt0 + xa10))
-        ge[i, 1] += cb * inv_b * (d1 * (-k1 * tt1 - xa21) + d2 * (-k2 * tt1 + xa11))
-        ge[i, 2] += cb * inv_b * (d1 * (-k1 * tt2 - xa22) + d2 * (-k2 * tt2 + xa12))
+        ge[i - 1, 0] += cbg * inv_a * (d1 * (-k1 * tt0 + xb20) + d2 * (-k2 * tt0 - xb10))
+        ge[i - 1, 1] += cbg * inv_a * (d1 * (-k1 * tt1 + xb21) + d2 * (-k2 * tt1 - xb11))
+        ge[i - 1, 2] += cbg * inv_a * (d1 * (-k1 * tt2 + xb22) + d2 * (-k2 * tt2 - xb12))
+        ge[i, 0] += cbg * inv_b * (d1 * (-k1 * tt0 - xa20) + d2 * (-k2 * tt0 + xa10))
+        ge[i, 1] += cbg * inv_b * (d1 * (-k1 * tt1 - xa21) + d2 * (-k2 * tt1 + xa11))
+        ge[i, 2] += cbg * inv_b * (d1 * (-k1 * tt2 - xa22) + d2 * (-k2 * tt2 + xa12))
         # d kappa1/d theta_j = -kb.m1_j / 2 ; d kappa2/d theta_j = -kb.m2_j / 2
         kbm1a = kb0 * m1[i - 1, 0] + kb1 * m1[i - 1, 1] + kb2 * m1[i - 1, 2]
         kbm1b = kb0 * m1[i, 0] + kb1 * m1[i, 1] + kb2 * m1[i, 2]
         kbm2a = kb0 * m2[i - 1, 0] + kb1 * m2[i - 1, 1] + kb2 * m2[i - 1, 2]
         kbm2b = kb0 * m2[i, 0] + kb1 * m2[i, 1] + kb2 * m2[i, 2]
-        grad_th[i - 1] += cb * (-0.5) * (d1 * kbm1a + d2 * kbm2a)
-        grad_th[i] += cb * (-0.5) * (d1 * kbm1b + d2 * kbm2b)
+        grad_th[i - 1] += cbg * (-0.5) * (d1 * kbm1a + d2 * kbm2a)
+        grad_th[i] += cbg * (-0.5) * (d1 * kbm1b + d2 * kbm2b)
         # twist
         mtw = theta[i] - theta[i - 1] + rt_out[i] - mbar[i]
         ct = ctwist[i]

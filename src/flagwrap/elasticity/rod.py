@@ -29,6 +29,8 @@ class RestState:
     cbend, ctwist : (N,) vertex coefficients ``A_i/l_i``, ``C_i/l_i`` the kernel uses
         (``bending/vor``, ``twist/vor`` for a uniform rod; joints change theirs:
         :meth:`with_vertex`). Ends unused (0).
+    angle_law : (N,) bool, vertices that measure curvature by the turning angle (lumped
+        joints; :mod:`flagwrap.elasticity._kernels`), ``kbar`` there in the same measure.
     """
 
     l0: np.ndarray
@@ -40,8 +42,11 @@ class RestState:
     stretch: float
     cbend: np.ndarray = None
     ctwist: np.ndarray = None
+    angle_law: np.ndarray = None
 
     def __post_init__(self):
+        if self.angle_law is None:
+            object.__setattr__(self, "angle_law", np.zeros(len(self.vor), np.bool_))
         if self.cbend is None:
             object.__setattr__(self, "cbend", _coefficients(self.bending, self.vor))
         if self.ctwist is None:
@@ -113,7 +118,7 @@ def elastic_energy(x, theta, base: Frames, rest: RestState) -> float:
     d1 = np.empty_like(base.d1)
     rt = np.empty_like(base.rt)
     return K.energy_grad(x, theta, base.t, base.d1, base.rt, rest.l0, rest.cbend,
-                         rest.ctwist, rest.kbar, rest.mbar, rest.stretch, gx, gth, d1, rt)
+                         rest.ctwist, rest.angle_law, rest.kbar, rest.mbar, rest.stretch, gx, gth, d1, rt)
 
 
 def elastic_forces(x, theta, base: Frames, rest: RestState):
@@ -123,7 +128,7 @@ def elastic_forces(x, theta, base: Frames, rest: RestState):
     d1 = np.empty_like(base.d1)
     rt = np.empty_like(base.rt)
     E = K.energy_grad(x, theta, base.t, base.d1, base.rt, rest.l0, rest.cbend,
-                      rest.ctwist, rest.kbar, rest.mbar, rest.stretch, gx, gth, d1, rt)
+                      rest.ctwist, rest.angle_law, rest.kbar, rest.mbar, rest.stretch, gx, gth, d1, rt)
     e = np.diff(x, axis=0)
     t = e / np.linalg.norm(e, axis=1)[:, None]
     return E, -gx, -gth, Frames(t, d1, rt)
