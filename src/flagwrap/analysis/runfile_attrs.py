@@ -56,11 +56,27 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None) -> BucklingAna
                      cfg.body.resolved_length(R), tq)
 
 
+def joint_summary(ds) -> dict:
+    """The joint's observables (issue 15): its kind, the angle between the motor's bond and the
+    filament's first bond at the end and its largest value [deg], and the largest bending and
+    twist torques at the joint [N m] (NaN for run files written before they were recorded)."""
+    nan = float("nan")
+    out = {"joint": str(ds.attrs.get("joint", "clamp")), "hook_angle_final_deg": nan,
+           "hook_angle_max_deg": nan, "hook_torque_max": nan, "hook_twist_torque_max": nan}
+    if "hook_angle" in ds.variables and ds.sizes.get("time", 0):
+        ang = np.degrees(ds["hook_angle"].values)
+        out["hook_angle_final_deg"] = float(ang[-1])
+        out["hook_angle_max_deg"] = float(ang.max())
+        out["hook_torque_max"] = float(np.abs(ds["hook_torque"].values).max())
+        out["hook_twist_torque_max"] = float(np.abs(ds["hook_twist_torque"].values).max())
+    return out
+
+
 def annotate(ds, analysis: BucklingAnalysis):
     """Return a copy of ``ds`` with the results of a computed ``analysis`` stored in it."""
     out = ds.drop_vars([v for v in VARIABLES if v in ds.variables])
     out.attrs = {k: v for k, v in ds.attrs.items() if not k.startswith(PREFIX)}
-    for k, v in analysis.summary().items():
+    for k, v in {**analysis.summary(), **joint_summary(ds)}.items():
         if isinstance(v, bool):
             v = int(v)
         out.attrs[PREFIX + k] = v
@@ -99,7 +115,7 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
     a = analyze_dataset(ds, analysis)
     if write:
         write_dataset_atomic(annotate(ds, a), path)
-    res = a.summary()
+    res = {**a.summary(), **joint_summary(ds)}
     res["params"] = a.params()
     res["path"] = str(path)
     res["run_status"] = str(ds.attrs.get("status", ""))

@@ -43,6 +43,11 @@ ROWS = [
     ("torque_peak_reduced", "CW torque peak N_m R/A", "{:+.3f}"),
     ("torque_peak_turns", "  at (t-t_s)/T", "{:.3f}"),
     ("torque_final_reduced", "final torque N_m R/A", "{:+.3f}"),
+    ("joint", "joint", "{}"),
+    ("hook_angle_final_deg", "joint angle final [deg]", "{:.2f}"),
+    ("hook_angle_max_deg", "joint angle max [deg]", "{:.2f}"),
+    ("hook_torque_max", "joint bending torque max [N m]", "{:.3g}"),
+    ("hook_twist_torque_max", "joint twist torque max [N m]", "{:.3g}"),
 ]
 
 

@@ -89,9 +89,9 @@ def run_geometry(case: Case, root, boundary: dict) -> dict:
 
 
 GEOMETRY_COLUMNS = ("psi_deg", "turns", "r_over_l", "r_over_rcell", "hi", "n_beads",
-                    "ccw_turns", "cw_turns", "density_mismatch")
+                    "ccw_turns", "cw_turns", "density_mismatch", "hook_stiffness")
 #: values of columns that rows written before the column existed lack
-_COLUMN_DEFAULTS = {"density_mismatch": 0.0}
+_COLUMN_DEFAULTS = {"density_mismatch": 0.0, "hook_stiffness": None}
 
 
 def brackets_from_rows(rows) -> list[dict]:

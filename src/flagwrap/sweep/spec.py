@@ -12,6 +12,10 @@ A sweep file names the cases by the dimensionless numbers of the paper's Fig. 5:
   no gravity); ``-0.02`` is 2 % lighter than the fluid, buoyant. With the fixed L below the
   gravity number ``G = (rho_f - rho) g pi a^2 L^3 / A`` is the same for every geometry at a
   given mismatch: ``G = -929.8 x mismatch`` (docs/gravity.md).
+* ``hook_stiffness``: a lumped hook (:class:`~flagwrap.params.Joint`) instead of the clamp,
+  given as ``k_h = A_h L / (A l_h)``, its bending spring in units of ``A/L`` (the clamp's
+  vertex has ``L/b = N - 1``; bacterial hooks ~0.4-4, docs/hook.md), with ``l_h = 0.01 L``
+  unless ``[base] joint.hook_length`` says otherwise (default: the clamp, keys unchanged).
 
 Every case becomes an SI :class:`~flagwrap.params.Config` with the paper's material
 (a = 1.5 mm, E = 1.5 MPa, nu = 0.49, eta = 1.1 Pa s) and a **fixed** arclength L = 0.4 m, so
@@ -82,7 +86,10 @@ BASE_CONFIG = {
 
 GEOMETRY_KEYS = ("psi_deg", "turns", "r_over_l")
 SPEED_KEYS = ("machin", "omega_ratio_scaling")
-CASE_KEYS = GEOMETRY_KEYS + ("r_over_rcell",) + SPEED_KEYS + ("hi", "density_mismatch")
+CASE_KEYS = GEOMETRY_KEYS + ("r_over_rcell",) + SPEED_KEYS + ("hi", "density_mismatch",
+                                                              "hook_stiffness")
+#: hook length of the ``hook_stiffness`` key, as a fraction of L (the paper: l_H/L ~ 1e-2)
+HOOK_LENGTH_RATIO = 0.01
 RUN_DEFAULTS = {"ccw_turns": 5.0, "cw_turns": 10.0, "stop_after": 2.0}
 #: the most cases one sweep file may expand to (checked before the grid is expanded)
 MAX_CASES = 100_000
@@ -153,6 +160,8 @@ class Case:
         hydrodynamic interactions on.
     density_mismatch : float or None
         ``(rho - rho_f) / rho_f`` of the filament; None: density-matched (no gravity).
+    hook_stiffness : float or None
+        ``k_h = A_h L / (A l_h)`` of a lumped hook; None: the clamp.
     run : dict
         ``ccw_turns``, ``cw_turns``, ``stop_after`` (None = full run).
     base : dict
@@ -169,6 +178,7 @@ class Case:
     base: dict = field(default_factory=dict)
     runner: str | None = None
     density_mismatch: float | None = None
+    hook_stiffness: float | None = None
 
     @property
     def machin_scaling(self) -> float:
@@ -185,6 +195,8 @@ class Case:
              "r_over_rcell": self.r_over_rcell, "hi": self.hi}
         if self.density_mismatch is not None:  # absent: the keys of density-matched sweeps stay
             g["density_mismatch"] = self.density_mismatch
+        if self.hook_stiffness is not None:  # absent: the keys of clamped sweeps stay
+            g["hook_stiffness"] = self.hook_stiffness
         return g
 
     def with_machin(self, machin: float) -> "Case":
@@ -207,11 +219,21 @@ class Case:
         if self.density_mismatch is not None:
             fil.pop("density", None)
             fil["density_mismatch"] = float(self.density_mismatch)
+        if self.hook_stiffness is not None:
+            from flagwrap import units
+
+            j = dict(d.get("joint") or {})
+            lh = float(j.get("hook_length", HOOK_LENGTH_RATIO * L))
+            A = units.bending_modulus(float(fil["youngs_modulus"]), float(fil["cross_section_radius"]))
+            j.update(kind="hook", hook_length=lh,
+                     hook_bending_modulus=float(self.hook_stiffness) * A * lh / L)
+            d["joint"] = j
         d["motor"] = {"machin": self.machin, "protocol": [
             {"direction": "ccw", "turns": float(self.run["ccw_turns"])},
             {"direction": "cw", "turns": float(self.run["cw_turns"])}]}
         d["name"] = f"psi{self.psi_deg:.3g}_n{self.turns:.3g}_M{self.machin:.5g}" + (
-            "" if self.density_mismatch is None else f"_dm{self.density_mismatch:+.4g}")
+            "" if self.density_mismatch is None else f"_dm{self.density_mismatch:+.4g}") + (
+            "" if self.hook_stiffness is None else f"_kh{self.hook_stiffness:.4g}")
         return d
 
     def config(self):
@@ -248,7 +270,8 @@ class Case:
                 "ccw_turns": float(self.run["ccw_turns"]), "cw_turns": float(self.run["cw_turns"]),
                 "stop_after": self.run.get("stop_after"),
                 "density_mismatch": 0.0 if self.density_mismatch is None else float(self.density_mismatch),
-                "gravity_number": self.gravity_number}
+                "gravity_number": self.gravity_number,
+                "hook_stiffness": None if self.hook_stiffness is None else float(self.hook_stiffness)}
 
     @property
     def gravity_number(self) -> float:
@@ -328,7 +351,18 @@ def _make_case(p: dict, run: dict, base: dict, mode: str, where: str, runner=Non
         if clash:
             raise UserInputError(f"sweep: [base] filament.{clash[0]} and the case key "
                                  "density_mismatch both set the filament density; keep one")
-    return Case(psi, n, rl, float(rr), machin, hi, dict(run), copy.deepcopy(base), runner, dm)
+    kh = p.get("hook_stiffness")
+    if kh is not None:
+        if isinstance(kh, bool) or not isinstance(kh, (int, float)) or not (math.isfinite(kh) and kh > 0):
+            raise UserInputError(f"{where}: hook_stiffness = A_h L/(A l_h) must be a finite number "
+                                 f"> 0 (the clamp's vertex has N - 1), got {kh!r}")
+        kh = float(kh)
+        jb = base.get("joint") or {}
+        clash = [k for k in ("kind", "hook_bending_modulus") if k in jb]
+        if clash:
+            raise UserInputError(f"sweep: [base] joint.{clash[0]} and the case key hook_stiffness "
+                                 "both set the hook; keep one (joint.hook_length may stay)")
+    return Case(psi, n, rl, float(rr), machin, hi, dict(run), copy.deepcopy(base), runner, dm, kh)
 
 
 def _table(data: dict, key: str) -> dict:
