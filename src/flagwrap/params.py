@@ -93,6 +93,12 @@ class Filament:
         bead radius used in the mobility [m]; ``None`` means ``a`` (the paper's choice).
     stretch_stiffness : float
         bond spring constant in units of ``A / b^3`` (default 1000: axial strain ~ F b^2/(1000 A)).
+    shape : {"helix", "straight"}
+        the stress-free shape: the helix (default), or a straight rod of length ``L`` down the
+        motor axis (Greenhill's and the hook's checks; the helix parameters then still set the
+        derived numbers that use ``R``: the body's ``radius_ratio``, ``Re`` and the scaling
+        line, so give ``body.radius`` explicitly). Any other rest polyline and twist: the Python
+        API, ``RodSystem(config, x0=..., theta0=...)``.
     """
 
     length: float
@@ -109,6 +115,7 @@ class Filament:
     hydrodynamic_radius: float | None = None
     stretch_stiffness: float = 1000.0
     density_mismatch: float | None = None
+    shape: str = "helix"
 
     def __post_init__(self):
         L = _positive("filament.length", self.length, "m")
@@ -160,6 +167,8 @@ class Filament:
         nu = _finite("filament.poisson_ratio", self.poisson_ratio)
         if not -1.0 < nu <= 0.5:
             raise UserInputError(f"filament.poisson_ratio must be in (-1, 0.5], got {nu}")
+        if self.shape not in ("helix", "straight"):
+            raise UserInputError(f"filament.shape must be 'helix' or 'straight', got {self.shape!r}")
         if self.handedness not in ("left", "right"):
             raise UserInputError(
                 f"filament.handedness must be 'left' or 'right', got {self.handedness!r}"
@@ -817,6 +826,8 @@ class Config:
         # pitch-like inputs are all stored after resolution; keep only pitch (canonical)
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)
+        if for_hash and self.filament.shape == "helix":  # added later: the default keeps keys
+            d["filament"].pop("shape", None)
         if for_hash:
             # added after results were stored: their defaults keep the keys
             if self.initial.is_default:

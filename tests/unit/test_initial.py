@@ -90,3 +90,25 @@ def test_cli_perturb_options(tmp_path, capsys):
     capsys.readouterr()
     assert main(["run", str(cfgp), "-o", str(tmp_path / "q.nc"), "--quiet", "--perturb", "-1"]) == 2
     assert "--perturb must be >= 0" in capsys.readouterr().err
+
+
+def test_straight_rest_shape_from_toml_and_cli(tmp_path):
+    import argparse
+
+    from flagwrap.cli.run import add_arguments, load
+    from flagwrap.io.config import config_to_toml, load_config
+    from flagwrap.model import RodSystem
+
+    p = argparse.ArgumentParser()
+    add_arguments(p)
+    cfg = load(p.parse_args(["examples/fig4a.toml", "--shape", "straight", "--self-contact"]))
+    assert cfg.filament.shape == "straight" and cfg.contact.self_contact
+    s = RodSystem(cfg)
+    assert np.allclose(s.x0[:, :2], 0.0) and np.allclose(s.x0[-1], [0.0, 0.0, -1.0])
+    info = s.forces(s.initial_y(), s.frames0)  # stress-free
+    assert np.abs(info.G).max() < 1e-10
+    path = tmp_path / "straight.toml"
+    path.write_text(config_to_toml(cfg))
+    assert load_config(path).filament.shape == "straight"
+    # the default keeps the keys of results stored before the option existed
+    assert "shape" not in load_config("examples/fig4a.toml").to_dict(for_hash=True)["filament"]

@@ -39,6 +39,10 @@ def add_arguments(p):
     p.add_argument("--seed", type=int, default=None, help="seed of the random perturbation (initial.seed)")
     p.add_argument("--perturb-mode", choices=["random", "lateral"], default=None,
                    help="shape of the perturbation (initial.mode)")
+    p.add_argument("--shape", choices=["helix", "straight"], default=None,
+                   help="stress-free shape of the filament (overrides filament.shape)")
+    p.add_argument("--self-contact", action="store_true",
+                   help="filament self-contact on (contact.self_contact = true)")
     p.add_argument("--checkpoint", metavar="PATH", help="checkpoint file (default <output>.ckpt.h5)")
     p.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
                    help="also checkpoint every N accepted steps (default: off)")
@@ -74,7 +78,12 @@ def load(args):
         except UserInputError as exc:  # name the option, not the config key
             raise UserInputError(str(exc).replace("initial.perturbation", "--perturb")
                                  .replace("initial.seed", "--seed")) from None
-    return cfg.replace(numerics=num, initial=ini)
+    fil, con = cfg.filament, cfg.contact
+    if getattr(args, "shape", None):
+        fil = dataclasses.replace(fil, shape=args.shape, pitch_angle_deg=None, turns=None)
+    if getattr(args, "self_contact", False):
+        con = dataclasses.replace(con, self_contact=True)
+    return cfg.replace(numerics=num, initial=ini, filament=fil, contact=con)
 
 
 def run(args) -> int:

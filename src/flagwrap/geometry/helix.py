@@ -111,8 +111,19 @@ def ramp_helix_positions(length, helix_radius, pitch, n_beads, handedness="left"
     return x
 
 
+def straight_positions(length, n_beads) -> np.ndarray:
+    """A straight rod of ``n_beads`` beads from the origin down the body axis (-z) [length unit
+    of ``length``], bonds exactly ``length / (n_beads - 1)``."""
+    x = np.zeros((int(n_beads), 3))
+    x[:, 2] = -length * np.arange(int(n_beads)) / (int(n_beads) - 1)
+    return x
+
+
 def filament_positions(fil, clamp=None) -> np.ndarray:
-    """Initial positions [m] of a :class:`flagwrap.params.Filament` with a clamp lead."""
+    """Initial positions [m] of a :class:`flagwrap.params.Filament` with a clamp lead
+    (``fil.shape = "straight"``: a straight rod, the lead does not apply)."""
+    if getattr(fil, "shape", "helix") == "straight":
+        return straight_positions(fil.length, fil.n_beads)
     if clamp is not None and clamp.lead == "ramp":
         lt = clamp.lead_turns
         return ramp_helix_positions(fil.length, fil.helix_radius, fil.pitch, fil.n_beads,
