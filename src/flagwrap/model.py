@@ -77,7 +77,7 @@ class RodSystem:
         self.bond = b
         # Step of the coloured finite-difference Jacobian, a fixed fraction of the bond: bending
         # and twist forces depend on displacements through angles ~ dx / b, so this keeps the
-        # relative accuracy of J the same at every N (docs/numerics.md, "Jacobian step").
+        # relative accuracy of J the same at every N (measured: docs/numerics.md, "Cost").
         self.fd_step = 6e-6 * b
         self.joint = self.clamp = joint
         self.rest: RestState = joint.rest(rest_state(

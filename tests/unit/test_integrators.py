@@ -346,3 +346,21 @@ def test_a_degenerate_stage_is_a_rejected_step(integrator, monkeypatch):
     assert not res.accepted and "bond of zero length" in res.reason
     if integrator.adaptive:
         assert res.h_next < 1e-2
+
+
+def test_tableaus_are_data_for_one_stepper():
+    from flagwrap.integrators import RosenbrockW, make_integrator
+    from flagwrap.integrators.controller import IController
+    from flagwrap.integrators.tableau import ROS2 as T2
+    from flagwrap.integrators.tableau import ROS34PW2 as T34
+
+    # the transformed coefficients satisfy the order conditions they encode: consistency
+    # (sum of m over a tableau's Gamma^-1 form reproduces b) for ROS34PW2, and ROS2's rate form
+    Gam = np.linalg.inv(np.diag(1.0 / np.diag(np.full(4, T34.gamma))) - T34.c)
+    assert np.allclose(T34.m @ Gam, [2.4212380706095346e-01, -1.2232505839045147e+00,
+                                     1.5452602553351020e+00, T34.gamma], rtol=1e-12)
+    assert T2.a[1, 0] * T2.gamma == pytest.approx(1.0) and T2.c[1, 0] * T2.gamma == pytest.approx(-2.0)
+    # a scheme given as a tableau runs through the same stepper (here ROS2's, by data)
+    custom = RosenbrockW(tol=1e-5, tableau=T2, controller=IController(safety=0.8))
+    assert custom.order == 2 and custom.filter_error and custom.controller.safety == 0.8
+    assert make_integrator("ros34pw2").tableau is T34

@@ -1,9 +1,10 @@
-"""Time steppers behind one interface (``step``, ``order``, ``adaptive``)."""
+"""Time steppers behind one interface (``step``, ``order``, ``adaptive``): the Rosenbrock
+W-methods are one stepper over tableaus (``rosenbrock.RosenbrockW``, ``tableau``), step-size
+control is its own object (``controller.IController``)."""
 
 from flagwrap.integrators.base import Integrator, StepResult
 from flagwrap.integrators.euler import ExplicitEuler
-from flagwrap.integrators.ros34pw2 import ROS34PW2
-from flagwrap.integrators.rosenbrock import ROS2
+from flagwrap.integrators.rosenbrock import ROS2, ROS34PW2, RosenbrockW
 
 REGISTRY = {"ros34pw2": ROS34PW2, "ros2": ROS2, "euler": ExplicitEuler}
 
@@ -15,5 +16,5 @@ def make_integrator(name: str, tol: float = 1e-5, linear_solver: str = "auto") -
     return cls() if name == "euler" else cls(tol=tol, linear_solver=linear_solver)
 
 
-__all__ = ["Integrator", "StepResult", "ExplicitEuler", "ROS2", "ROS34PW2", "make_integrator",
-           "REGISTRY"]
+__all__ = ["Integrator", "StepResult", "ExplicitEuler", "ROS2", "ROS34PW2", "RosenbrockW",
+           "make_integrator", "REGISTRY"]

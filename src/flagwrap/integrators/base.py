@@ -35,34 +35,31 @@ class Integrator:
 
 
 class AdaptiveMixin:
-    """Step-size control shared by the embedded-pair schemes.
-
-    ``h_next = h min(grow, max(shrink, safety err^(-1/k)))`` with ``k`` = order of the error
-    estimate + 1; a step is rejected when the scaled error exceeds 1 or anything is non-finite.
-    """
+    """Error-controlled stepping: a tolerance, a step-size controller
+    (:class:`~flagwrap.integrators.controller.IController`, built from ``safety``, ``grow``,
+    ``shrink`` unless one is given) and the end of a step (:meth:`conclude`)."""
 
     default_tol: float = 1e-4
     default_filter: bool = False
 
     def __init__(self, tol: float | None = None, safety: float = 0.9, grow: float = 4.0,
                  shrink: float = 0.2, filter_error: bool | None = None,
-                 linear_solver: str = "auto"):
+                 linear_solver: str = "auto", controller=None):
+        from flagwrap.integrators.controller import IController
+
         self.tol = self.default_tol if tol is None else tol
-        self.safety = safety
-        self.grow = grow
-        self.shrink = shrink
+        self.controller = controller or IController(safety, grow, shrink)
         self.filter_error = self.default_filter if filter_error is None else filter_error
         self.linear_solver = linear_solver
 
     def reject(self, h, reason) -> StepResult:
-        return StepResult(False, None, None, h * self.shrink, np.inf, reason)
+        return StepResult(False, None, None, self.controller.after_failure(h), np.inf, reason)
 
     def conclude(self, system, base, y_new, err, h, estimate_order) -> StepResult:
         if not np.isfinite(err) or not np.all(np.isfinite(y_new)):
             return self.reject(h, "non-finite state")
-        fac = self.safety * (1.0 / max(err, 1e-10)) ** (1.0 / (estimate_order + 1))
-        h_next = h * min(self.grow, max(self.shrink, fac))
-        if err > 1.0:
+        h_next = self.controller.propose(h, err, estimate_order)
+        if not self.controller.accept(err):
             return StepResult(False, None, None, h_next, err, "error above tolerance")
         try:
             info = system.forces(y_new, base)

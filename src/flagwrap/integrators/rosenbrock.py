@@ -1,68 +1,85 @@
-"""ROS2: a two-stage, L-stable, linearly implicit Rosenbrock (W-) method with error control.
+"""One Rosenbrock W-method step driven by a tableau (:mod:`flagwrap.integrators.tableau`).
 
-Verwer, Spee, Blom & Hundsdorfer, SIAM J. Sci. Comput. 20, 1456 (1999), with
-``gamma = 1 + 1/sqrt(2)`` and ``W = I - gamma h Mob J_G``::
-
-    W k1 = f(y_n)
-    W k2 = f(y_n + h k1) - 2 k1
-    y_{n+1} = y_n + 3/2 h k1 + 1/2 h k2            (order 2 for any W)
-    err     = y_{n+1} - (y_n + h k1) = h (k1 + k2)/2 (embedded linearly implicit Euler)
-
-``J_G`` is the Jacobian of the elastic + contact forces (coloured finite differences) and
-``Mob`` the mobility at ``y_n``; freezing the mobility in ``W`` keeps order 2 because ROS2 is
-a W-method. All stiff elastic modes (stretching, twist, bending) are damped implicitly, so the
-step is set by accuracy (``tol``), not by the stiffest spring.
+``W = I - gamma h Mob(y_n) J_G``: ``J_G`` the Jacobian of the generalized forces (exact
+stretching Hessian + coloured finite differences + the interactions' Hessians) and the
+mobility frozen at ``y_n``. The schemes are W-methods, so they keep their order for this
+approximate Jacobian (Rang & Angermann 2005; Verwer et al. 1999); all stiff elastic modes are
+damped implicitly, so the step is set by accuracy (``tol``), not by the stiffest spring.
+:class:`ROS34PW2` (default) and :class:`ROS2` are this stepper with their tableaus.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from flagwrap.integrators import tableau as T
 from flagwrap.integrators.base import (AdaptiveMixin, Integrator, StepResult, error_weights,
                                       scaled_error)
 from flagwrap.integrators.linear import SingularW, make_w
 
-GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
 
+class RosenbrockW(AdaptiveMixin, Integrator):
+    """A Rosenbrock W-method step for the tableau ``self.tableau`` (class attribute, or
+    ``RosenbrockW(tableau=...)``)."""
 
-class ROS2(AdaptiveMixin, Integrator):
-    order = 2
     adaptive = True
-    name = "rosenbrock"
+    tableau: T.RosenbrockTableau = T.ROS34PW2
 
-    default_tol = 1e-3
-    default_filter = True  # see the error-estimate comment in step()
+    def __init__(self, tol=None, *, tableau: T.RosenbrockTableau | None = None, **kw):
+        if tableau is not None:
+            self.tableau = tableau
+        tb = self.tableau
+        self.default_tol, self.default_filter = tb.default_tol, tb.filter_error
+        self.order, self.name = tb.order, tb.name
+        super().__init__(tol, **kw)
 
     def step(self, system, y, base, info, h, omega) -> StepResult:
-        G0 = info.G
-        f0 = system.apply_mobility(y, G0)
-        f0[system.i_phi] = omega
+        tb = self.tableau
+        gh = tb.gamma * h
         try:
-            # the stages k_i are rates: y moves by ~h k_i, so an iterative solve needs them to
-            # kappa x tol / h
-            W = make_w(self.linear_solver, system, y, base, G0, GAMMA * h,
-                       err_scale=error_weights(system, self.tol) / h)
-            k1 = W.solve(f0)
+            # stage increments u_i enter y_new and the error estimate with O(1) weights, so
+            # an iterative solve needs each to kappa x the step tolerance
+            W = make_w(self.linear_solver, system, y, base, info.G, gh,
+                       err_scale=error_weights(system, self.tol))
         except SingularW as exc:
             return self.reject(h, f"singular W ({exc})")
-        y1 = y + h * k1
-        if not np.all(np.isfinite(y1)):
-            return self.reject(h, "non-finite stage")
-        try:
-            f1, _ = system.rhs(y1, base, omega)
-        except ZeroDivisionError:  # a stage so far off that a bond has zero length
-            return self.reject(h, "degenerate stage (a bond of zero length)")
-        try:
-            k2 = W.solve(f1 - 2.0 * k1)
-        except SingularW as exc:
-            return self.reject(h, str(exc))
-        y_new = y + h * (1.5 * k1 + 0.5 * k2)
-        # Shampine's filter: W^-1 applied to the raw estimate removes the spurious error of
-        # the stiff (instantly relaxing) components, which would otherwise cap the step.
-        err_vec = 0.5 * h * (k1 + k2)
+        a, c = tb.a, tb.c
+        U = np.empty((tb.stages, system.ny))
+        for i in range(tb.stages):
+            if i == 0:
+                f = system.apply_mobility(y, info.G)
+                f[system.i_phi] = omega
+            else:
+                Yi = y + a[i, :i] @ U[:i]
+                if not np.all(np.isfinite(Yi)):
+                    return self.reject(h, "non-finite stage")
+                try:
+                    f, _ = system.rhs(Yi, base, omega)
+                except ZeroDivisionError:  # a stage so far off that a bond has zero length
+                    return self.reject(h, "degenerate stage (a bond of zero length)")
+            rhs = f + (c[i, :i] @ U[:i]) / h if i else f
+            try:
+                U[i] = W.solve(gh * rhs)
+            except SingularW as exc:
+                return self.reject(h, str(exc))
+        y_new = y + tb.m @ U
+        err_vec = tb.e @ U
         if self.filter_error:
             err_vec = W.solve(err_vec)
         err = scaled_error(system, err_vec, self.tol)
-        return self.conclude(system, base, y_new, err, h, estimate_order=1)
+        return self.conclude(system, base, y_new, err, h, estimate_order=tb.estimate_order)
+
+
+class ROS34PW2(RosenbrockW):
+    """4 stages, order 3, L-stable, embedded order 2 (:data:`tableau.ROS34PW2`); the default."""
+
+    tableau = T.ROS34PW2
+    order, name = 3, "ros34pw2"
+
+
+class ROS2(RosenbrockW):
+    """2 stages, order 2, L-stable, embedded order 1, Shampine's error filter
+    (:data:`tableau.ROS2`)."""
+
+    tableau = T.ROS2
+    order, name = 2, "ros2"
