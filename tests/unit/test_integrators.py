@@ -354,9 +354,9 @@ def test_tableaus_are_data_for_one_stepper():
     from flagwrap.integrators.tableau import ROS2 as T2
     from flagwrap.integrators.tableau import ROS34PW2 as T34
 
-    # the transformed coefficients satisfy the order conditions they encode: consistency
-    # (sum of m over a tableau's Gamma^-1 form reproduces b) for ROS34PW2, and ROS2's rate form
-    Gam = np.linalg.inv(np.diag(1.0 / np.diag(np.full(4, T34.gamma))) - T34.c)
+    # the transformed coefficients give back the published ones (b = m Gamma, Gamma from c)
+    # for ROS34PW2, and ROS2's rate form (a21 = 1/gamma, c21 = -2/gamma)
+    Gam = np.linalg.inv(np.diag(np.full(4, 1.0 / T34.gamma)) - T34.c)
     assert np.allclose(T34.m @ Gam, [2.4212380706095346e-01, -1.2232505839045147e+00,
                                      1.5452602553351020e+00, T34.gamma], rtol=1e-12)
     assert T2.a[1, 0] * T2.gamma == pytest.approx(1.0) and T2.c[1, 0] * T2.gamma == pytest.approx(-2.0)
