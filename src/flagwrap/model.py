@@ -98,6 +98,8 @@ class RodSystem:
         self.sl_x = self.layout["x"]
         self.sl_th = self.layout["theta"]
         self.i_phi = self.layout.block("phi").start  # the motor angle's index in y
+        # the fused kernels and the dense/banded W assemblies take y in this block order
+        assert [b.name for b in self.layout.blocks] == ["x", "theta", "phi"], self.layout
         # hydrodynamics (radius in core units)
         self.radius = fil.bead_radius / L
         num = config.numerics

@@ -129,10 +129,13 @@ class Simulation:
         s = self.system
         if not np.all(np.isfinite(info.G)):
             k = int(np.flatnonzero(~np.isfinite(info.G))[0])
-            if k < s.sl_x.stop:
-                where = f"bead {s.nc + k // 3} (force component {'xyz'[k % 3]})"
+            block, i = s.layout.locate(k)
+            if block == "x":
+                where = f"bead {s.nc + i // 3} (force component {'xyz'[i % 3]})"
+            elif block == "theta":
+                where = f"bond {s.ec + i} (twist torque)"
             else:
-                where = f"bond {s.ec + k - s.sl_th.start} (twist torque)"
+                where = f"unknown {k} ({block})"
             return f"non-finite generalized force {info.G[k]} on {where}"
         if s.N > s.nc and np.min(info.distance[s.nc:]) <= 0.0:
             i = int(np.argmin(info.distance[s.nc:])) + s.nc

@@ -39,3 +39,13 @@ def test_bad_layouts_are_refused():
         DofLayout([("x", "velocity", 3)])
     with pytest.raises(ValueError, match="negative"):
         DofLayout([("x", "position", -1)])
+
+
+def test_locate_names_the_block_of_an_unknown():
+    from flagwrap.system.layout import DofLayout
+
+    lay = DofLayout.clamped_filament(3, 4)
+    assert lay.locate(0) == ("x", 0) and lay.locate(8) == ("x", 8)
+    assert lay.locate(9) == ("theta", 0) and lay.locate(13) == ("phi", 0)
+    with pytest.raises(IndexError):
+        lay.locate(14)

@@ -86,6 +86,13 @@ class DofLayout:
                 worst = max(worst, np.abs(err[b.slice]).max() / (TOL_FACTOR[b.kind] * tol))
         return float(worst)
 
+    def locate(self, k: int) -> tuple[str, int]:
+        """``(block name, index within the block)`` of unknown ``k``."""
+        for b in self.blocks:
+            if b.start <= k < b.start + b.size:
+                return b.name, k - b.start
+        raise IndexError(f"unknown {k} outside the layout (size {self.size})")
+
     def free(self) -> np.ndarray:
         """Indices of the unknowns that are not prescribed (e.g. for a static Newton solve)."""
         return np.concatenate([np.arange(b.start, b.start + b.size) for b in self.blocks
