@@ -28,7 +28,7 @@ from threadpoolctl import threadpool_limits
 
 from flagwrap.cases import get_case
 from flagwrap.integrators import ROS2, ExplicitEuler
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.params import Phase
 from flagwrap.simulation import Simulation
 

@@ -42,7 +42,7 @@ from flagwrap.cases import get_case
 from flagwrap.hydrodynamics.mobility import (FMMMobility, JAXMobility, RPYMobility,
                                              backend_missing)
 from flagwrap.integrators import make_integrator
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.params import Filament
 
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flagwrap.integrators import make_integrator
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 
 TWO_PI = 2.0 * math.pi
 # the per-frame records of a Trajectory, in the order Simulation._record computes them

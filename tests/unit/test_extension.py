@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from flagwrap.io.config import load_config
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.params import Phase
 from flagwrap.simulation import Simulation
 

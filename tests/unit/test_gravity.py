@@ -10,7 +10,7 @@ import pytest
 
 from flagwrap.errors import UserInputError
 from flagwrap.io.config import config_from_dict
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.units import G_ACCEL, gravity_number
 
 from conftest import make_config

@@ -12,7 +12,7 @@ from flagwrap.elasticity.rod import elastic_energy, elastic_forces, initial_fram
 from flagwrap.errors import UserInputError
 from flagwrap.io.config import load_config
 from flagwrap.joints import LumpedHook, make_joint
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.params import Joint, Phase
 from flagwrap.simulation import Simulation, simulate
 

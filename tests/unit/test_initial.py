@@ -6,7 +6,7 @@ import pytest
 from flagwrap.errors import UserInputError
 from flagwrap.geometry.perturbation import displacement
 from flagwrap.io.config import config_from_dict, config_to_toml, load_config
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 
 from conftest import make_config
 
@@ -97,7 +97,7 @@ def test_straight_rest_shape_from_toml_and_cli(tmp_path):
 
     from flagwrap.cli.run import add_arguments, load
     from flagwrap.io.config import config_to_toml, load_config
-    from flagwrap.model import RodSystem
+    from flagwrap.system.rod_system import RodSystem
 
     p = argparse.ArgumentParser()
     add_arguments(p)

@@ -8,7 +8,7 @@ import pytest
 from flagwrap.integrators import ROS2, ROS34PW2, ExplicitEuler
 from flagwrap.integrators.linear import BandedW, DenseW, KrylovW, SparseW
 from flagwrap.integrators.ros34pw2 import A_T, C_T, GAMMA, M_T
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 
 from conftest import make_config, paper_filament
 

@@ -9,7 +9,7 @@ import pytest
 from flagwrap.errors import UserInputError
 from flagwrap.interactions.self_contact import SelfContact, count_crossings, max_self_range
 from flagwrap.io.config import load_config
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.params import Contact, Phase
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flagwrap.geometry.frames import rotation_matrix
-from flagwrap.model import RodSystem
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.params import CellBody, Numerics
 from flagwrap.simulation import Simulation
 

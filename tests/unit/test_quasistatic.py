@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from flagwrap.errors import UserInputError
-from flagwrap.quasistatic import law_force_at_extension, stretch_helix, stretched_helix_positions
+from flagwrap.elasticity.stretching_test import law_force_at_extension, stretch_helix, stretched_helix_positions
 from flagwrap.theory.stretching import StretchedHelix
 
 SI = dict(radius=15e-3, pitch=34e-3, youngs_modulus=1.2 * 1.33e6, poisson_ratio=0.49, semi_axis_a=1.5e-3)

@@ -58,10 +58,10 @@ def straight_positions(n_beads: int) -> np.ndarray:
 
 
 def straight_rod_system(config):
-    """:class:`~flagwrap.model.RodSystem` of ``config`` with a straight stress-free rest shape
+    """:class:`~flagwrap.system.rod_system.RodSystem` of ``config`` with a straight stress-free rest shape
     (and straight initial state) instead of its helix: the clamped bond and the whole rod on
     the body axis, below the body."""
-    from flagwrap.model import RodSystem
+    from flagwrap.system.rod_system import RodSystem
 
     return RodSystem(config, x0=straight_positions(config.filament.n_beads))
 
@@ -100,7 +100,7 @@ class Equilibrium:
 
 def _system_at(config, G: float, straight: bool):
     """The system of ``config`` at gravity number ``G``: straight rest shape or its own helix."""
-    from flagwrap.model import RodSystem
+    from flagwrap.system.rod_system import RodSystem
 
     cfg = with_gravity_number(config, G)
     return straight_rod_system(cfg) if straight else RodSystem(cfg)

@@ -8,7 +8,7 @@ import numpy as np
 def displacement(n_beads: int, amplitude: float, mode: str = "random", seed: int = 0) -> np.ndarray:
     """Bead displacements (N, 3) whose largest norm is ``amplitude``, growing as ``(s/L)^2``
     from the clamped end (so beads 0 and 1 move by O(b^2), and by exactly 0 after
-    :meth:`~flagwrap.model.RodSystem.initial_y` keeps the clamp's beads).
+    :meth:`~flagwrap.system.rod_system.RodSystem.initial_y` keeps the clamp's beads).
 
     ``"random"``: in each direction the sum of ``sin(k pi s / L)`` for k = 1..4 with standard
     normal amplitudes from ``numpy.random.default_rng(seed)`` plus a constant; ``"lateral"``:

@@ -1,7 +1,7 @@
 """Integrator interface.
 
 An integrator advances ``dy/dt = Mob(y) G(y) + omega e_phi`` of a
-:class:`flagwrap.model.RodSystem` by one step ``h`` at constant motor speed ``omega``. It is a
+:class:`flagwrap.system.rod_system.RodSystem` by one step ``h`` at constant motor speed ``omega``. It is a
 pure function of (system, y, base, info, h, omega): the time loop (:mod:`flagwrap.simulation`)
 owns time, output and the phase switches of the motor.
 """

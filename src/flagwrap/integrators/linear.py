@@ -51,7 +51,7 @@ class DenseW:
     """
 
     def __init__(self, system, y, base, G0, gamma_h):
-        from flagwrap._system_kernels import w_transpose_dense
+        from flagwrap.system.kernels import w_transpose_dense
 
         rows, cols, vals = system.force_jacobian_coo(y, base, G0)
         Mxx, mt = system.mobility_blocks(y)
@@ -271,7 +271,7 @@ class BandedW:
     def __init__(self, system, y, base, G0, gamma_h, width=0, triplets=None):
         from scipy.linalg.lapack import dgbtrf
 
-        from flagwrap._system_kernels import band_from_triplets
+        from flagwrap.system.kernels import band_from_triplets
 
         rows, cols, vals = triplets or system.force_jacobian_coo(y, base, G0, nonlocal_terms=False)
         # pairs farther apart than the chain is long do not exist: clamp (short chains)

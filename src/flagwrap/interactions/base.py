@@ -1,6 +1,6 @@
 """The interface of an interaction: an extra energy term ``U(x, theta)`` of the system.
 
-:class:`flagwrap.model.RodSystem` evaluates its fused kernel (the filament's elasticity, the
+:class:`flagwrap.system.rod_system.RodSystem` evaluates its fused kernel (the filament's elasticity, the
 joint, the body contact, gravity) and then every interaction in ``system.interactions``:
 
 * ``energy_grad(x, theta, grad_x, grad_theta) -> float``: the energy [A/L]; *adds*

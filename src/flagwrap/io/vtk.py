@@ -125,12 +125,12 @@ class ElasticForces:
 
     Notes
     -----
-    Builds :class:`flagwrap.model.RodSystem` once (for the rest state and scales); each call
+    Builds :class:`flagwrap.system.rod_system.RodSystem` once (for the rest state and scales); each call
     costs one energy-gradient evaluation.
     """
 
     def __init__(self, config):
-        from flagwrap.model import RodSystem
+        from flagwrap.system.rod_system import RodSystem
 
         self.system = RodSystem(config)
         self.L = config.scales.length

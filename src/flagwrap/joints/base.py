@@ -1,7 +1,7 @@
 """The interface of a joint between the motor and the filament.
 
 A joint decides three things, each a method, so that a new joint is a new class and no edit of
-:class:`flagwrap.model.RodSystem`, the integrators or the loop:
+:class:`flagwrap.system.rod_system.RodSystem`, the integrators or the loop:
 
 1. **shape** (:meth:`Joint.shape`): the joint may add beads to the stress-free shape (the
    resolved hook inserts its short bonds); the default keeps it.
@@ -9,7 +9,7 @@ A joint decides three things, each a method, so that a new joint is a new class 
    (``RestState.with_vertex``); the lumped hook replaces vertex 1's ``A/b`` by ``A_h/l_h``.
 3. **kinematics**: which beads and twist angles the motor prescribes, as functions of the
    motor angle ``phi`` (``n_beads``, ``n_edges``, :meth:`positions`, :meth:`theta`,
-   :meth:`generalized_force`). The fused force kernel (:mod:`flagwrap._system_kernels`)
+   :meth:`generalized_force`). The fused force kernel (:mod:`flagwrap.system.kernels`)
    implements one kind, a rigid rotation about ``axis`` of the reference beads ``x_ref`` and
    twist angles ``theta_ref + twist_rate phi``; every joint so far is driven that way
    (:class:`~flagwrap.joints.clamp.AxialClamp`'s kinematics).

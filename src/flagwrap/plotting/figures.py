@@ -34,7 +34,7 @@ def fig3(outdir: str | Path = "out/figures", *, n_beads: int = 201, n_steps: int
     L = 305 mm, E = 1.2 x 1.33 MPa, nu = 0.49): main text Eq. 1 for the round section
     ``a = 1.5 mm`` with ``z/L = cos psi + F/(pi E a^2)``; the SI's elliptic law
     (``2a = 3.19 mm``, ``2b = 2.88 mm``, derived form, see :mod:`flagwrap.theory.stretching`);
-    the quasi-static bead simulation (:func:`flagwrap.quasistatic.stretch_helix`, round
+    the quasi-static bead simulation (:func:`flagwrap.elasticity.stretching_test.stretch_helix`, round
     section, moment-free ends pulled by their end points) for the helix itself and for one
     ``long_factor`` times longer (same ``R``, ``P``, more turns; the law does not depend on
     ``L`` at fixed ``z/L``). Right: relative deviation of the bead force from Eq. 1.
@@ -60,7 +60,7 @@ def fig3(outdir: str | Path = "out/figures", *, n_beads: int = 201, n_steps: int
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from flagwrap.quasistatic import law_force_at_extension, stretch_helix
+    from flagwrap.elasticity.stretching_test import law_force_at_extension, stretch_helix
     from flagwrap.theory.stretching import StretchedHelix
 
     round_h = StretchedHelix(semi_axis_a=1.5e-3, **FIG3_HELIX)

@@ -1,4 +1,4 @@
-"""Fused numba kernels of :class:`flagwrap.model.RodSystem` (one call per force evaluation).
+"""Fused numba kernels of :class:`flagwrap.system.rod_system.RodSystem` (one call per force evaluation).
 
 ``generalized_forces`` unpacks the state vector (clamp + free beads/bonds), evaluates the
 elastic energy and gradient, the body repulsion and gravity, and packs ``G = -dU/dy``;
