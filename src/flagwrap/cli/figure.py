@@ -13,6 +13,8 @@ Figures (registry FIGURES, extended as figures are added):
   gravity  M_c of the Fig. 4(a) helix against the buoyancy G (flagwrap sweep
         examples/sweeps/gravity-fig4a.toml), its static rise at M = 0, and the Fig. 5 fit per
         density mismatch (examples/sweeps/gravity-fig5.toml); docs/gravity.md
+  hook  M_c against the hook stiffness for three helices, and their final states
+        (flagwrap sweep examples/sweeps/hook.toml and hook-grid.toml); docs/hook.md
 
 Example::
 
@@ -41,6 +43,12 @@ def _gravity(outdir):
     return gravity_figure(outdir)
 
 
+def _hook(outdir):
+    from flagwrap.plotting.hook import hook_figure
+
+    return hook_figure(outdir)
+
+
 def _show_run(label, r):
     print(f"  {label:<28} M = {r.machin:9.2f}  {'BUCKLED' if r.buckled else 'stable ':7s}  "
           f"{'reused' if r.reused else 'simulated'}", flush=True)
@@ -66,6 +74,7 @@ PLANS = {
     "fig5": "nothing: drawn from the sweep rows in out/sweeps/fig5 (or fig5-quick + fig5-boundary)",
     "gravity": "the static equilibria of the Fig. 4(a) helix (~40 s); the rest from the sweep rows "
                "in out/sweeps/gravity-fig4a and gravity-fig5",
+    "hook": "nothing: drawn from the sweep rows in out/sweeps/hook (and hook-grid if present)",
 }
 #: cache folders a figure reads its runs from
 CACHES = {"fig4": ("out/critical", "out/paper"), "fig6": ("out/critical", "out/waiting"),
@@ -83,6 +92,8 @@ FIGURES = {
     "fig5": _fig5,
     # issue 18: the threshold against the buoyancy, from the gravity sweeps
     "gravity": _gravity,
+    # issue 15: the threshold and the final state against the hook's stiffness
+    "hook": _hook,
 }
 
 
