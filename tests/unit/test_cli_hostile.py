@@ -57,6 +57,16 @@ def make_world(d: Path) -> Path:
                                  if "[body]" in tiny_toml() else tiny_toml() + "\n[body]\nradius_ratio = 1e9\n")
     (d / "dm.toml").write_text(tiny_toml().replace("[filament]", "[filament]\ndensity_mismatch = -1.5"))
     (d / "rho.toml").write_text(tiny_toml().replace("[filament]", "[filament]\ndensity = 0.0"))
+    # issue 15: the hook and self-contact
+    (d / "hookneg.toml").write_text(tiny_toml() + "\n[joint]\nkind = 'hook'\nhook_length = -0.001\n"
+                                    "hook_bending_modulus = 1e-8\n")
+    (d / "hookzero.toml").write_text(tiny_toml() + "\n[joint]\nkind = 'hook'\nhook_length = 0.004\n"
+                                     "hook_bending_modulus = 0.0\n")
+    (d / "hooklong.toml").write_text(tiny_toml() + "\n[joint]\nkind = 'hook'\nhook_length = 1.0\n"
+                                     "hook_bending_modulus = 1e-8\n")
+    (d / "selfrange.toml").write_text(tiny_toml().replace("[contact]", "[contact]\nself_contact = true\nself_range = 500.0")
+                                      if "[contact]" in tiny_toml() else
+                                      tiny_toml() + "\n[contact]\nself_contact = true\nself_range = 500.0\n")
     (d / "big.toml").write_text("name = 'big'\n[grid]\npsi_deg = [" + ", ".join(str(30 + 0.01 * i) for i in range(1000))
                                 + "]\nturns = [" + ", ".join(str(1.5 + 0.001 * i) for i in range(1000)) + "]\nmachin = 100.0\n")
     return d
@@ -99,6 +109,10 @@ HOSTILE = [
     (["run", "{d}/body.toml", "-o", "{d}/new.nc", "--quiet"], "body.radius_ratio"),
     (["run", "{d}/dm.toml", "-o", "{d}/new.nc", "--quiet"], "filament.density_mismatch"),
     (["run", "{d}/rho.toml", "-o", "{d}/new.nc", "--quiet"], "filament.density"),
+    (["run", "{d}/hookneg.toml", "-o", "{d}/new.nc", "--quiet"], "joint.hook_length"),
+    (["run", "{d}/hookzero.toml", "-o", "{d}/new.nc", "--quiet"], "joint.hook_bending_modulus"),
+    (["run", "{d}/hooklong.toml", "-o", "{d}/new.nc", "--quiet"], "joint.hook_length"),
+    (["run", "{d}/selfrange.toml", "-o", "{d}/new.nc", "--quiet"], "contact.self_range"),
     (["viscosity", "rod", "{d}/rod.csv"], "viscosity eta"),
     (["snapshots", "{d}/good.nc", "-t", "nan", "-o", "{d}/s.png"], "nan"),
     (["movie", "{d}/good.nc", "--size", "13x7", "-o", "{d}/m.mp4", "--quiet"], "nearest allowed: 160x96"),
