@@ -54,3 +54,22 @@ def tiny_run(tmp_path_factory):
     path = tmp_path_factory.mktemp("tiny") / "tiny.nc"
     write_run(simulate(config_from_dict(tomllib.loads(tiny_toml()))), path)
     return path
+
+
+def fd_gradient(energy, x, theta, h=1e-6):
+    """Central differences of ``energy(x, theta)`` over every coordinate of ``x`` (N, 3) and
+    ``theta`` (N-1,): the oracle of the gradient tests (error O(h^2) + rounding/h)."""
+    gx = np.zeros_like(x)
+    for i in range(len(x)):
+        for k in range(3):
+            xp, xm = x.copy(), x.copy()
+            xp[i, k] += h
+            xm[i, k] -= h
+            gx[i, k] = (energy(xp, theta) - energy(xm, theta)) / (2 * h)
+    gt = np.zeros_like(theta)
+    for j in range(len(theta)):
+        tp, tm = theta.copy(), theta.copy()
+        tp[j] += h
+        tm[j] -= h
+        gt[j] = (energy(x, tp) - energy(x, tm)) / (2 * h)
+    return gx, gt

@@ -9,6 +9,8 @@ from flagwrap.elasticity.rod import elastic_energy, elastic_forces, initial_fram
 from flagwrap.geometry.frames import rotation_matrix
 from flagwrap.geometry.helix import ramp_helix_positions
 
+from conftest import fd_gradient
+
 
 def setup(n=20, stretch=1e4, twist=1 / 1.49):
     x0 = ramp_helix_positions(1.0, 0.075, 0.167, n, "left", 0.5)
@@ -37,20 +39,7 @@ def test_forces_are_minus_gradient_of_energy(rng, stretch):
     x0, th0, fr, rest = setup(stretch=stretch)
     x, th, base = perturbed(rng, x0, fr, rest)
     E, F, tau, _ = elastic_forces(x, th, base, rest)
-    h = 1e-6
-    g = np.zeros_like(x)
-    for i in range(len(x)):
-        for k in range(3):
-            xp, xm = x.copy(), x.copy()
-            xp[i, k] += h
-            xm[i, k] -= h
-            g[i, k] = (elastic_energy(xp, th, base, rest) - elastic_energy(xm, th, base, rest)) / (2 * h)
-    gt = np.zeros_like(th)
-    for j in range(len(th)):
-        tp, tm = th.copy(), th.copy()
-        tp[j] += h
-        tm[j] -= h
-        gt[j] = (elastic_energy(x, tp, base, rest) - elastic_energy(x, tm, base, rest)) / (2 * h)
+    g, gt = fd_gradient(lambda xx, tt: elastic_energy(xx, tt, base, rest), x, th)
     assert np.abs(F + g).max() / np.abs(g).max() < 1e-5
     assert np.abs(tau + gt).max() / np.abs(gt).max() < 1e-5
 

@@ -16,6 +16,8 @@ from flagwrap.system.rod_system import RodSystem
 from flagwrap.params import Joint, Phase
 from flagwrap.simulation import Simulation, simulate
 
+from conftest import fd_gradient
+
 
 def fig4a(turns=1.0):
     cfg = load_config("examples/fig4a.toml")
@@ -151,20 +153,7 @@ def test_hook_energy_gradient_matches_finite_differences(rng, bend):
     th = 0.3 * rng.standard_normal(7)
     _, _, _, base = elastic_forces(xd, th, fr, rest)
     E, Fx, tau, _ = elastic_forces(xd, th, base, rest)
-    h = 1e-6
-    g = np.zeros_like(xd)
-    for i in range(len(xd)):
-        for k in range(3):
-            xp, xm = xd.copy(), xd.copy()
-            xp[i, k] += h
-            xm[i, k] -= h
-            g[i, k] = (elastic_energy(xp, th, base, rest) - elastic_energy(xm, th, base, rest)) / (2 * h)
-    gt = np.zeros_like(th)
-    for j in range(len(th)):
-        tp, tm = th.copy(), th.copy()
-        tp[j] += h
-        tm[j] -= h
-        gt[j] = (elastic_energy(xd, tp, base, rest) - elastic_energy(xd, tm, base, rest)) / (2 * h)
+    g, gt = fd_gradient(lambda xx, tt: elastic_energy(xx, tt, base, rest), xd, th)
     # central differences: O(h^2) truncation and ~1e-10 rounding in E over h, relative 1e-6
     assert np.abs(Fx + g).max() <= 1e-6 * np.abs(g).max()
     assert np.abs(tau + gt).max() <= 1e-6 * np.abs(gt).max()

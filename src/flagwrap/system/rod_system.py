@@ -317,47 +317,38 @@ class RodSystem:
         nb, nc, ec = self.nb, self.nc, self.ec
         groups = []
 
-        def bead_rows(k):  # k: full bead index; rows affected: beads k-2..k+2, bonds k-2..k+1
+        def stencil_rows(beads, bonds):  # the free unknowns among these beads and bonds
             rows = []
-            for m in range(k - 2, k + 3):
+            for m in beads:
                 if nc <= m < self.N:
                     rows += [3 * (m - nc) + c for c in range(3)]
-            for j in range(k - 2, k + 2):
+            for j in bonds:
                 if ec <= j < self.N - 1:
                     rows.append(3 * nb + (j - ec))
             return rows
 
-        def edge_rows(j):  # bond j: beads j-1..j+2, bonds j-1..j+1
-            rows = []
-            for m in range(j - 1, j + 3):
-                if nc <= m < self.N:
-                    rows += [3 * (m - nc) + c for c in range(3)]
-            for i in range(j - 1, j + 2):
-                if ec <= i < self.N - 1:
-                    rows.append(3 * nb + (i - ec))
-            return rows
+        def bead_rows(k):  # k: full bead index; rows affected: beads k-2..k+2, bonds k-2..k+1
+            return stencil_rows(range(k - 2, k + 3), range(k - 2, k + 2))
 
-        for start in range(5):
-            for c in range(3):
-                cols, rows_l, cols_l = [], [], []
-                for k in range(nc + start, self.N, 5):
-                    col = 3 * (k - nc) + c
-                    cols.append(col)
-                    rr = bead_rows(k)
-                    rows_l += rr
-                    cols_l += [col] * len(rr)
-                if cols:
-                    groups.append((np.array(cols), np.array(rows_l), np.array(cols_l)))
-        for start in range(5):
+        def edge_rows(j):  # bond j: beads j-1..j+2, bonds j-1..j+1
+            return stencil_rows(range(j - 1, j + 3), range(j - 1, j + 2))
+
+        def group(members, column, rows_of):  # one colour: columns and their (row, col) pairs
             cols, rows_l, cols_l = [], [], []
-            for j in range(ec + start, self.N - 1, 5):
-                col = 3 * nb + (j - ec)
+            for k in members:
+                col = column(k)
                 cols.append(col)
-                rr = edge_rows(j)
+                rr = rows_of(k)
                 rows_l += rr
                 cols_l += [col] * len(rr)
             if cols:
                 groups.append((np.array(cols), np.array(rows_l), np.array(cols_l)))
+
+        for start in range(5):
+            for c in range(3):
+                group(range(nc + start, self.N, 5), lambda k, c=c: 3 * (k - nc) + c, bead_rows)
+        for start in range(5):
+            group(range(ec + start, self.N - 1, 5), lambda j: 3 * nb + (j - ec), edge_rows)
         self._colors = groups
         g_ptr = np.cumsum([0] + [len(g[0]) for g in groups]).astype(np.int64)
         e_ptr = np.cumsum([0] + [len(g[1]) for g in groups]).astype(np.int64)
