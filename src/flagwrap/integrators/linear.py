@@ -3,29 +3,20 @@
 * :class:`DenseW` assembles ``W`` (ny x ny) and LU-factorises it once per step: fastest for
   short chains (N ~ 60 -> ny ~ 240), O(N^3) time and O(N^2) memory.
 * :class:`KrylovW` never forms a dense matrix: ``J`` is sparse (banded, from the coloured
-  Jacobian), ``Mob`` is applied matrix-free (O(N^2) RPY product, O(N) memory) and GCR with
-  subspace recycling across the four stages is right-preconditioned by the banded LU of the
-  near-field ``I - gamma h Mob_near J``. It stops at a relative residual ``rtol = 1e-3``
-  once the estimated solution error is also below 0.1 x the step's error tolerance for
-  every unknown (the class docstring says why both). Measured (long chain of
-  benchmarks/scaling.py): N = 61, 0.5 turn from rest, residual test alone, free end 7.0e-4 L
-  from a tol = 1e-7 reference against 7.3e-4 L for the exact LU (the time-stepping error
-  dominates; rtol 1e-4 and 1e-5 give 7.5e-4 and 7.3e-4); 2.6 RPY products per stage at
-  N = 1000 (scipy's restarted GMRES needed ~8-13).
+  Jacobian), ``Mob`` is applied matrix-free and GCR with subspace recycling across the four
+  stages is right-preconditioned by the banded LU of the near-field ``I - gamma h Mob_near J``.
+  It stops at a relative residual ``rtol = 1e-3`` once the estimated solution error is also
+  below ``KAPPA`` x the step's error tolerance for every unknown (the class docstring says why
+  both).
 * :class:`NearW` drops the far field from ``W`` altogether (a W-method keeps its order for
-  any ``W``): one banded LU and one full ``Mob F`` per stage. Its error estimate is looser and
-  the long-wavelength stretching modes, whose relaxation the far field speeds up, limit its
-  step: ~15x the steps of the exact ``W`` (N = 500: 846 steps + 292 rejections vs 59 + 18),
-  so it lost to KrylovW everywhere measured; kept as an option.
+  any ``W``): one banded LU and one full ``Mob F`` per stage; its looser ``W`` costs many more
+  steps, so it is an option, not a default.
 * :class:`BandedW` (default with HI off) and :class:`SparseW` are exact LUs for a local
   mobility: banded, O(N).
 
 ``make_w(kind, ...)`` picks one; ``"auto"``: banded with HI off, dense up to
-``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover is measured (one core, same
-tolerance, whole intervals from rest): Fig. 4(a) helix refined at fixed L, 0.2 turn: N = 91
-(357 unknowns) dense 0.66 s vs GCR 0.97 s, N = 121 (477) 1.30 vs 1.11 s; benchmarks/scaling.py's
-chain (fixed bond): N = 95 (373) 1.60 vs 1.56 s over 0.3 turn, N = 120 (473) 1.69 vs 1.20 s
-over 0.2 turn (docs/numerics.md).
+``AUTO_CROSSOVER_NY`` unknowns, krylov above. The crossover, the solvers' accuracy and cost
+and the stopping rule are measured in docs/numerics.md ("Long chains").
 """
 
 from __future__ import annotations
