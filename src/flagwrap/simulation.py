@@ -196,7 +196,8 @@ class Simulation:
             config_toml=self._checkpoint_toml()), self.checkpoint_path)
 
     def run(self, t_end: float | None = None, progress: bool = False, y0=None,
-            base=None, t0: float = 0.0, resume=None, budget_used=(0, 0.0)) -> Trajectory:
+            base=None, t0: float = 0.0, resume=None, budget_used=(0, 0.0),
+            stop=None) -> Trajectory:
         """Integrate from ``t0`` to ``t_end`` (default: the end of the motor protocol; beyond
         it the motor keeps its last speed).
 
@@ -206,6 +207,9 @@ class Simulation:
         that this one continues (a run split into chunks), counted against
         ``numerics.max_steps`` / ``max_wall_time``; these budgets are per invocation
         otherwise, so a run stopped by one can be resumed.
+        ``stop``: a terminating event, called with the trajectory after every recorded frame;
+        a non-empty string it returns ends the run there as "completed" with that message
+        (e.g. :class:`flagwrap.analysis.critical.BuckledStop`).
         """
         s = self.system
         sched = s.schedule
@@ -310,6 +314,11 @@ class Simulation:
                 if t >= next_save - eps:
                     self._record(traj, t, y, info, omega)
                     next_save += self.save_dt
+                    if stop is not None:
+                        why = stop(traj)
+                        if why:
+                            traj.status, traj.message = "completed", why
+                            break
                 over = None
                 if traj.n_steps - n_steps0 >= steps_left:
                     over = f"reached numerics.max_steps={self.max_steps}"
@@ -333,11 +342,11 @@ class Simulation:
                     raise _Stop(f"t/T={t / TWO_PI:.6g}: {over}", budget=True)
             keep_last_state()
             traj.status = "completed"
-        except _Stop as stop:
+        except _Stop as halt:
             keep_last_state()  # every path to here leaves (t, y, info) at the last good state
             traj.status = "failed"
-            traj.message = str(stop)
-            if fresh and not stop.budget and t < t_start + self.save_dt:
+            traj.message = str(halt)
+            if fresh and not halt.budget and t < t_start + self.save_dt:
                 # a fresh run that failed at once: say if it started in contact
                 traj.message += self._start_contact_hint(info_start)
         except (KeyboardInterrupt, SystemError) as exc:

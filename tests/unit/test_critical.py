@@ -189,3 +189,32 @@ def test_failed_run_is_not_called_stable(tmp_path, cfg):
     s = CriticalSearch(cache=RunCache(tmp_path, runner=failing))
     with pytest.raises(UserInputError, match="entered the cell body"):
         s.compute(cfg)
+
+
+def test_buckled_stop_event_ends_the_uninterrupted_run():
+    """Oracle: the full run. The event stops the loop once buckled, and the frames it kept are
+    the full run's, bit for bit (no restart of the integrator)."""
+    import dataclasses
+
+    import numpy as np
+
+    from flagwrap.analysis.buckling import WaitingTime
+    from flagwrap.analysis.critical import BuckledStop
+    from flagwrap.io.config import load_config
+    from flagwrap.params import Phase
+    from flagwrap.simulation import TWO_PI, Simulation
+
+    cfg = load_config("examples/fig4a.toml")
+    fil = dataclasses.replace(cfg.filament, n_beads=21, pitch_angle_deg=None, pitch=None, turns=2.0)
+    cfg = cfg.replace(filament=fil, motor=dataclasses.replace(
+        cfg.motor, machin=1500.0, protocol=(Phase("ccw", 1.0), Phase("cw", 8.0))))
+    full = Simulation(cfg).run()
+    sim = Simulation(cfg)
+    ev = sim.run(stop=BuckledStop(sim.system.schedule, stop_after=1.0))
+    assert full.ok and ev.ok and "stopped early" in ev.message
+    n = len(ev.t)
+    assert n < len(full.t)
+    assert np.array_equal(np.asarray(full.x)[:n], np.asarray(ev.x))
+    x = np.asarray(full.x)
+    w = WaitingTime().compute(np.asarray(full.t) / TWO_PI, x[:, -1, 2] - x[:, 0, 2], np.asarray(full.omega))
+    assert w.buckled and ev.t[-1] / TWO_PI - w.crossing_turns >= 1.0 - 1e-9

@@ -193,6 +193,50 @@ def simulate_until_buckled(cfg, stop_after: float | None = 2.0, chunk_turns: flo
     return total
 
 
+class BuckledStop:
+    """Terminating event of the time loop (``Simulation.run(stop=...)``): once buckled
+    (:class:`~flagwrap.analysis.buckling.WaitingTime` on the free-end height so far), with the
+    crossing at least ``stop_after`` turns back, the run ends. Checked every ``every_turns``
+    from one turn after the first CW phase starts (the schedule ``sched``), as
+    :func:`simulate_until_buckled` checks at its chunk edges.
+
+    Unlike the chunked runs it does not restart the integrator, so the frames up to the stop
+    are those of the uninterrupted run, bit for bit. :func:`simulate_until_buckled` keeps the
+    chunks because the sweeps' and searches' cached results were made that way (their step
+    sizes restart at every chunk edge, which moves a run by up to the tolerance and can flip a
+    verdict next to M_c): switching them is a change of the result keys and a re-measurement.
+    """
+
+    def __init__(self, sched, stop_after: float = 2.0, every_turns: float = 1.0, waiting=None):
+        from flagwrap.analysis.buckling import WaitingTime
+        from flagwrap.simulation import TWO_PI
+
+        self.waiting = waiting if waiting is not None else WaitingTime()
+        self.stop_after = float(stop_after)
+        self.every = float(every_turns)
+        cw = [seg for seg in sched.segments if seg.omega < 0]
+        self.next_check = (cw[0].t0 / TWO_PI + 1.0) if cw else math.inf
+        self._two_pi = TWO_PI
+
+    def __call__(self, traj) -> str:
+        import numpy as np
+
+        from flagwrap.analysis.buckling import WaitingTime
+
+        now = traj.t[-1] / self._two_pi
+        if now < self.next_check - 1e-9:
+            return ""
+        self.next_check += self.every
+        turns = np.asarray(traj.t) / self._two_pi
+        x = np.asarray(traj.x)
+        w = WaitingTime(**self.waiting.params()).compute(turns, x[:, -1, 2] - x[:, 0, 2],
+                                                         np.asarray(traj.omega))
+        if w.buckled and now - w.crossing_turns >= self.stop_after:
+            return (f"stopped early at t/T = {now:.3f}: buckled (crossing at "
+                    f"{w.crossing_turns:.3f}), {self.stop_after:g} turns later")
+        return ""
+
+
 def simulate_and_analyse(cfg, path: Path, stop_after: float | None = 2.0) -> dict:
     """Default runner: simulate ``cfg`` (:func:`simulate_until_buckled`), write the run file to
     ``path``, analyse it (stored in the file) and return the summary."""
