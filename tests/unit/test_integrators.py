@@ -364,3 +364,20 @@ def test_tableaus_are_data_for_one_stepper():
     custom = RosenbrockW(tol=1e-5, tableau=T2, controller=IController(safety=0.8))
     assert custom.order == 2 and custom.filter_error and custom.controller.safety == 0.8
     assert make_integrator("ros34pw2").tableau is T34
+
+
+def test_reused_dense_w_buffers_give_the_same_solve():
+    # the time loop's dense W factorises in buffers the system keeps (no fresh arrays per step):
+    # the solve must be the fresh-array solve, bit for bit, and the buffer is really reused
+    from flagwrap.integrators.linear import DenseW
+
+    s, y, info = _rest_state(11)
+    rhs = np.random.default_rng(0).standard_normal(s.ny)
+    fresh = DenseW(s, y, s.frames0, info.G, 0.01).solve(rhs)
+    w1 = DenseW(s, y, s.frames0, info.G, 0.01, reuse=True)
+    buf = s._wt_buffer
+    assert np.array_equal(w1.solve(rhs), fresh)
+    DenseW(s, y, s.frames0, info.G, 0.02, reuse=True)
+    assert s._wt_buffer is buf
+    Mxx, _ = s.mobility_blocks(y, reuse=True)
+    assert Mxx is s._mxx_buffer and np.array_equal(Mxx, s.mobility_blocks(y)[0])

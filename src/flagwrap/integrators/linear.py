@@ -37,16 +37,26 @@ class SingularW(Exception):
 class DenseW:
     """Dense LU of ``W``, assembled straight from the sparse Jacobian triplets.
 
+    ``reuse=True`` (what the integrators ask for through :func:`make_w`) assembles and
+    factorises in buffers the system keeps, so a step allocates no ~0.5 MB arrays; the LU is
+    then valid until the next reusing ``DenseW`` of the same system (one per step).
+
     The kernel writes ``W^T`` row by row in C order, which is ``W`` in Fortran order: LAPACK
     factorises that buffer in place, without the transposing copy a C-ordered ``W`` needs.
     """
 
-    def __init__(self, system, y, base, G0, gamma_h):
+    def __init__(self, system, y, base, G0, gamma_h, reuse: bool = False):
         from flagwrap.system.kernels import w_transpose_dense
 
         rows, cols, vals = system.force_jacobian_coo(y, base, G0)
-        Mxx, mt = system.mobility_blocks(y)
-        WT = np.empty((system.ny, system.ny))
+        Mxx, mt = system.mobility_blocks(y, reuse=reuse)
+        WT = None
+        if reuse:  # one W per step: factorise in the system's buffer (no fresh ~0.5 MB array)
+            WT = system.__dict__.get("_wt_buffer")
+        if WT is None:
+            WT = np.empty((system.ny, system.ny))
+            if reuse:
+                system._wt_buffer = WT
         w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT)
         try:
             self.lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
@@ -336,7 +346,7 @@ def make_w(kind, system, y, base, G0, gamma_h, err_scale=None):
     if kind == "sparse":
         return SparseW(system, y, base, G0, gamma_h)
     if kind == "dense":
-        return DenseW(system, y, base, G0, gamma_h)
+        return DenseW(system, y, base, G0, gamma_h, reuse=True)
     if kind == "krylov":
         return KrylovW(system, y, base, G0, gamma_h, err_scale=err_scale)
     if kind == "near":

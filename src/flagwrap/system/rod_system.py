@@ -294,10 +294,18 @@ class RodSystem:
         Mb /= self.machin
         return Mb, self.twist_mobility
 
-    def mobility_blocks(self, y: np.ndarray):
-        """``Mob`` as its two non-zero blocks: dense translational (3nb, 3nb), twist diagonal (ne,)."""
+    def mobility_blocks(self, y: np.ndarray, reuse: bool = False):
+        """``Mob`` as its two non-zero blocks: dense translational (3nb, 3nb), twist diagonal (ne,).
+
+        ``reuse``: written into one buffer the system keeps (valid until the next such call):
+        the time loop's dense W, which needs it once per step, then allocates nothing."""
         x, _, _ = self.unpack(y)
-        Mxx = self.mobility.matrix(x[self.nc:])
+        out = None
+        if reuse:
+            out = self.__dict__.get("_mxx_buffer")
+            if out is None:
+                out = self._mxx_buffer = np.empty((3 * self.nb, 3 * self.nb))
+        Mxx = self.mobility.matrix(x[self.nc:], out=out)
         Mxx /= self.machin
         return Mxx, self.twist_mobility
 
