@@ -21,7 +21,7 @@ import pytest
 
 from flagwrap.cli.main import main
 from flagwrap.errors import UserInputError
-from flagwrap.io.checkpoint import read_checkpoint
+from flagwrap.io.checkpoint import CHECKPOINT_FORMAT, read_checkpoint
 from flagwrap.io.config import config_from_dict, tomllib
 from flagwrap.io.runfile import read_run
 from flagwrap.simulation import simulate
@@ -173,7 +173,7 @@ def test_resume_refuses_other_version_and_damaged_files(checkpoint, tmp_path):
         read_checkpoint(runfile)
     with h5py.File(runfile, "w") as f:
         f.attrs["format"] = "flagwrap checkpoint"
-        f.attrs["checkpoint_format"] = 1
+        f.attrs["checkpoint_format"] = CHECKPOINT_FORMAT
     with pytest.raises(UserInputError, match="incomplete or damaged"):
         read_checkpoint(runfile)
 
@@ -189,3 +189,12 @@ def test_checkpoint_records_are_the_trajectory_records():
     from flagwrap.simulation import _RECORDS
 
     assert RECORD_NAMES == _RECORDS
+
+
+def test_a_checkpoint_from_before_the_joint_records_is_named_as_such(checkpoint):
+    # format 1 had no hook/interaction records: refused by its format, not as "damaged"
+    cfg, ck = checkpoint
+    with h5py.File(ck, "r+") as f:
+        f.attrs["checkpoint_format"] = 1
+    with pytest.raises(UserInputError, match="checkpoint format 1; this flagwrap .* reads format 2"):
+        read_checkpoint(ck)

@@ -34,7 +34,8 @@ from flagwrap import __version__
 from flagwrap.errors import UserInputError
 from flagwrap.io.atomic import atomic_write
 
-CHECKPOINT_FORMAT = 1
+#: 2: the joint records (hook_angle, hook_torque, hook_twist_torque) and interaction_energy
+CHECKPOINT_FORMAT = 2
 _MAGIC = "flagwrap checkpoint"
 #: the per-frame records of a trajectory (flagwrap.simulation._RECORDS, repeated here so that
 #: reading a checkpoint does not import the simulator; tests/unit/test_checkpoint.py checks)
