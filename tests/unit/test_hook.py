@@ -130,6 +130,9 @@ def test_rod_on_a_soft_hook_turned_slowly_bends_to_its_torque_balance(segments, 
     want = _tilt_balance(k, F, lever)
     assert abs(psi[-1] / want - 1) < tol
     assert np.ptp(psi[-5:]) < 1e-4 * want  # steady
+    if segments == 0:  # the recorded joint torque is the spring's k_h psi (straight rest)
+        torque = tr.arrays()["hook_torque"][-1]
+        assert torque == pytest.approx(k * psi[-1], rel=1e-6)
 
 
 @pytest.mark.parametrize("bend", [0.3, 1.2, 2.2])

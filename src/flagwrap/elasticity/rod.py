@@ -6,6 +6,7 @@ All quantities in core units (length L, energy A/L, A = 1): see :mod:`flagwrap.u
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,6 +67,15 @@ class RestState:
         if mbar is not None:
             mb[i] = mbar
         return dataclasses.replace(self, cbend=cb, ctwist=ct, kbar=kb, mbar=mb)
+
+
+def turning_angle_scale(kb_norm: float) -> float:
+    """``g = psi / |kb|`` with ``psi = 2 atan(|kb|/2)``: the factor that turns the discrete
+    curvature ``|kb| = 2 tan(psi/2)`` into the turning angle (an ``angle_law`` vertex; the
+    kernel, :mod:`flagwrap.elasticity._kernels`, computes the same inline)."""
+    if kb_norm <= 1e-12:
+        return 1.0
+    return 2.0 * math.atan(0.5 * kb_norm) / kb_norm
 
 
 def _coefficients(modulus, vor: np.ndarray) -> np.ndarray:

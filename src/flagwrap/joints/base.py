@@ -25,6 +25,8 @@ import math
 
 import numpy as np
 
+from flagwrap.elasticity.rod import turning_angle_scale
+
 
 class Joint:
     """Base class: the identity shape and stiffness; subclasses set the kinematics."""
@@ -46,15 +48,17 @@ class Joint:
 
         Angle: between the motor's bond (bond 0) and :attr:`exit_bond`. Torques at
         :attr:`vertex`: ``cb |kappa - kappa_bar|`` and ``ct (m - m_bar)`` (the elastic
-        kernel's terms, :mod:`flagwrap.elasticity._kernels`).
+        kernel's terms, :mod:`flagwrap.elasticity._kernels`; at an ``angle_law`` vertex the
+        curvatures in the turning-angle measure its ``kappa_bar`` is in).
         """
         i = self.vertex
         t = frames.t
         c = float(np.clip(np.dot(t[0], t[self.exit_bond]), -1.0, 1.0))
         ta, tb = t[i - 1], t[i]
         kb = 2.0 * np.cross(ta, tb) / (1.0 + np.dot(ta, tb))
-        k1 = 0.5 * np.dot(m2[i - 1] + m2[i], kb)
-        k2 = -0.5 * np.dot(m1[i - 1] + m1[i], kb)
+        g = turning_angle_scale(float(np.linalg.norm(kb))) if rest.angle_law[i] else 1.0
+        k1 = 0.5 * g * np.dot(m2[i - 1] + m2[i], kb)
+        k2 = -0.5 * g * np.dot(m1[i - 1] + m1[i], kb)
         bend = rest.cbend[i] * math.hypot(k1 - rest.kbar[i, 0], k2 - rest.kbar[i, 1])
         twist = rest.ctwist[i] * (theta[i] - theta[i - 1] + frames.rt[i] - rest.mbar[i])
         return math.acos(c), float(bend), float(twist)

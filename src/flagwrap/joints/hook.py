@@ -31,6 +31,7 @@ import dataclasses
 
 import numpy as np
 
+from flagwrap.elasticity.rod import turning_angle_scale
 from flagwrap.joints.clamp import AxialClamp
 
 
@@ -51,8 +52,7 @@ class LumpedHook(AxialClamp):
         c = float(np.clip(ta @ tb, -1.0, 1.0))
         #: rest turning angle at the hook and the factor psi/|kb| that rescales its curvature
         self.rest_angle = float(np.arccos(c))
-        kn = 2.0 * np.sqrt(max(1.0 - c, 0.0) / (1.0 + c))
-        self._g0 = self.rest_angle / kn if kn > 1e-12 else 1.0
+        self._g0 = turning_angle_scale(2.0 * np.sqrt(max(1.0 - c, 0.0) / (1.0 + c)))
 
     def rest(self, rest):
         r = rest.with_vertex(1, cbend=self.k_bend, ctwist=self.k_twist,
