@@ -1,10 +1,11 @@
 """The interface of a joint between the motor and the filament.
 
-A joint decides three things, each a method, so that a new joint is a new class and no edit of
+A joint decides three things, so that a new joint is a new class and no edit of
 :class:`flagwrap.system.rod_system.RodSystem`, the integrators or the loop:
 
-1. **shape** (:meth:`Joint.shape`): the joint may add beads to the stress-free shape (the
-   resolved hook inserts its short bonds); the default keeps it.
+1. **shape**: a joint is built for the stress-free shape it is given, and may have added beads
+   to it first (the resolved hook inserts its short bonds: :func:`flagwrap.joints.insert_hook`);
+   :func:`flagwrap.joints.make_joint` returns the joint with its shape.
 2. **stiffness** (:meth:`Joint.rest`): the joint's vertices get their own coefficients
    (``RestState.with_vertex``); the lumped hook replaces vertex 1's ``A/b`` by ``A_h/l_h``.
 3. **kinematics**: which beads and twist angles the motor prescribes, as functions of the
@@ -29,16 +30,13 @@ from flagwrap.elasticity.rod import turning_angle_scale
 
 
 class Joint:
-    """Base class: the identity shape and stiffness; subclasses set the kinematics."""
+    """Base class: the identity stiffness and the observables; subclasses set the kinematics."""
 
     #: the joint's vertex (where its torque is measured) and the first bond of the filament
     #: proper (whose angle to the motor axis is the joint's angle)
     vertex = 1
     exit_bond = 1
     kind = "joint"
-
-    def shape(self, x0: np.ndarray, theta0: np.ndarray):
-        return x0, theta0
 
     def rest(self, rest):
         return rest
