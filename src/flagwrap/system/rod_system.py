@@ -189,8 +189,8 @@ class RodSystem:
                 b.length if has_body else 0.0, b.sigma if has_body else 0.0,
                 b.strength if has_body else 0.0, b.c2 if has_body else 0.0, self.gravity)
 
-    def forces(self, y: np.ndarray, base: Frames) -> ForceInfo:
-        """Generalized forces ``G = -dU/dy`` and everything computed with them."""
+    def _fused(self, y: np.ndarray, base: Frames):
+        """The fused kernel alone: ``(G, x, theta, gx, gth, d1, rt, dist, E, Ec)``."""
         N = self.N
         G = np.empty(self.ny)
         x = np.empty((N, 3))
@@ -202,6 +202,12 @@ class RodSystem:
         dist = np.empty(N)
         E, Ec = SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base),
                                       G, x, theta, gx, gth, d1, rt, dist)
+        return G, x, theta, gx, gth, d1, rt, dist, E, Ec
+
+    def forces(self, y: np.ndarray, base: Frames) -> ForceInfo:
+        """Generalized forces ``G = -dU/dy`` and everything computed with them."""
+        N = self.N
+        G, x, theta, gx, gth, d1, rt, dist, E, Ec = self._fused(y, base)
         Ei = 0.0
         if self.interactions:
             gxe = np.zeros((N, 3))
@@ -215,16 +221,6 @@ class RodSystem:
         t = np.empty((N - 1, 3))
         SK.unit_tangents(x, t)
         return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist, Ei)
-
-    def _core_G(self, y, base) -> np.ndarray:
-        """``G`` of the fused kernel alone (without the interactions)."""
-        N = self.N
-        G = np.empty(self.ny)
-        SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base), G,
-                              np.empty((N, 3)), np.empty(N - 1), np.empty((N, 3)),
-                              np.empty(N - 1), np.empty_like(base.d1), np.empty_like(base.rt),
-                              np.empty(N))
-        return G
 
     def interaction_jacobian_coo(self, y, which: str = "all"):
         """``-d^2U/dy^2`` of the interactions as triplets over the unknowns; ``which``: "all",
@@ -380,7 +376,7 @@ class RodSystem:
         if self._colors is None:
             self._build_colors()
         if self.interactions:  # the kernel differences its own forces: it needs its own G
-            G0 = self._core_G(y, base)
+            G0 = self._fused(y, base)[0]
         elif G0 is None:
             G0 = self.forces(y, base).G
         g_ptr, g_cols, e_ptr, e_rows, e_cols = self._colors_flat
