@@ -181,16 +181,31 @@ def simulate_until_buckled(cfg, stop_after: float | None = 2.0, chunk_turns: flo
             base = total.final_frames
             if t1 >= sched.t_end - 1e-9 or t1 <= t_cw0:
                 continue
-            turns = np.asarray(total.t) / TWO_PI
-            x = np.asarray(total.x)
-            h = x[:, -1, 2] - x[:, 0, 2]  # core length unit is L
-            w = WaitingTime(**waiting.params()).compute(turns, h, np.asarray(total.omega))
-            if w.buckled and turns[-1] - w.crossing_turns >= stop_after:
-                total.message = (f"stopped early at t/T = {turns[-1]:.3f}: buckled (crossing at "
-                                 f"{w.crossing_turns:.3f}), {stop_after:g} turns later")
+            why = buckled_long_enough(total, waiting, stop_after)
+            if why:
+                total.message = why
                 break
         total.wall_time = _time.perf_counter() - start
     return total
+
+
+def buckled_long_enough(traj, waiting, stop_after: float) -> str:
+    """``"stopped early ..."`` if the trajectory so far has buckled by ``waiting``'s criterion
+    (:class:`~flagwrap.analysis.buckling.WaitingTime` on the free-end height, core length L)
+    with the crossing at least ``stop_after`` turns back; ``""`` otherwise."""
+    import numpy as np
+
+    from flagwrap.analysis.buckling import WaitingTime
+    from flagwrap.simulation import TWO_PI
+
+    turns = np.asarray(traj.t) / TWO_PI
+    x = np.asarray(traj.x)
+    w = WaitingTime(**waiting.params()).compute(turns, x[:, -1, 2] - x[:, 0, 2],
+                                                np.asarray(traj.omega))
+    if w.buckled and turns[-1] - w.crossing_turns >= stop_after:
+        return (f"stopped early at t/T = {turns[-1]:.3f}: buckled (crossing at "
+                f"{w.crossing_turns:.3f}), {stop_after:g} turns later")
+    return ""
 
 
 class BuckledStop:
@@ -219,22 +234,10 @@ class BuckledStop:
         self._two_pi = TWO_PI
 
     def __call__(self, traj) -> str:
-        import numpy as np
-
-        from flagwrap.analysis.buckling import WaitingTime
-
-        now = traj.t[-1] / self._two_pi
-        if now < self.next_check - 1e-9:
+        if traj.t[-1] / self._two_pi < self.next_check - 1e-9:
             return ""
         self.next_check += self.every
-        turns = np.asarray(traj.t) / self._two_pi
-        x = np.asarray(traj.x)
-        w = WaitingTime(**self.waiting.params()).compute(turns, x[:, -1, 2] - x[:, 0, 2],
-                                                         np.asarray(traj.omega))
-        if w.buckled and now - w.crossing_turns >= self.stop_after:
-            return (f"stopped early at t/T = {now:.3f}: buckled (crossing at "
-                    f"{w.crossing_turns:.3f}), {self.stop_after:g} turns later")
-        return ""
+        return buckled_long_enough(traj, self.waiting, self.stop_after)
 
 
 def simulate_and_analyse(cfg, path: Path, stop_after: float | None = 2.0) -> dict:
