@@ -12,7 +12,6 @@ out like the test's fixture; "changed" = a file that existed before differs afte
 from __future__ import annotations
 
 import argparse
-import hashlib
 import importlib.util
 import resource
 import subprocess
