@@ -826,10 +826,10 @@ class Config:
         # pitch-like inputs are all stored after resolution; keep only pitch (canonical)
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)
-        if for_hash and self.filament.shape == "helix":  # added later: the default keeps keys
-            d["filament"].pop("shape", None)
         if for_hash:
             # added after results were stored: their defaults keep the keys
+            if self.filament.shape == "helix":
+                d["filament"].pop("shape", None)
             if self.initial.is_default:
                 d.pop("initial", None)
             if self.joint.is_default:

@@ -76,6 +76,14 @@ def segment_closest(p0, p1, q0, q1):
 
 
 @nb.njit(cache=True)
+def _pair_law(d, cut, sigma, eps, k2):
+    """The pair energy ``U(d)`` (module docstring) and ``U'(d)/d``, for ``0 < d < cut``."""
+    s6 = (sigma / d) ** 6
+    U = 4.0 * eps * (s6 * s6 - s6) + eps - 0.5 * k2 * (d - cut) ** 2
+    return U, (4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / d - k2 * (d - cut)) / d
+
+
+@nb.njit(cache=True)
 def self_contact_energy_grad(x, cut, sigma, eps, c2, first, grad):
     """Energy of the segment-pair repulsion of the chain ``x`` (N, 3); adds ``dU/dx`` to
     ``grad``. Segment ``i`` meets segments ``j >= first[i]`` only (its contour neighbours are
@@ -106,9 +114,8 @@ def self_contact_energy_grad(x, cut, sigma, eps, c2, first, grad):
                 dmin = d
             if d >= cut or d <= 0.0:
                 continue
-            s6 = (sigma / d) ** 6
-            E += 4.0 * eps * (s6 * s6 - s6) + eps - 0.5 * k2 * (d - cut) ** 2
-            dU = (4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / d - k2 * (d - cut)) / d
+            U, dU = _pair_law(d, cut, sigma, eps, k2)
+            E += U
             gx, gy, gz = dU * dx, dU * dy, dU * dz
             grad[i, 0] += (1.0 - s) * gx
             grad[i, 1] += (1.0 - s) * gy
@@ -152,7 +159,6 @@ class SelfContact:
         self.eps = float(strength)
         self.c2 = float(c2)
         self.rest_lengths = None if rest_lengths is None else np.asarray(rest_lengths, float)
-        self.bond = float(bond)
         # bonds whose contour distance is within the cut-off are neighbours, not contacts
         self.exclude = int(math.ceil(self.cut / bond)) + 1
         self._first_n = None
@@ -203,8 +209,7 @@ def _pair_grad(P, cut, sigma, eps, k2, out):
     out[:] = 0.0
     if d >= cut or d <= 0.0:
         return
-    s6 = (sigma / d) ** 6
-    dU = (4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / d - k2 * (d - cut)) / d
+    dU = _pair_law(d, cut, sigma, eps, k2)[1]
     w = (1.0 - s, s, -(1.0 - t), -t)
     for k in range(4):
         out[3 * k] = w[k] * dU * dx
