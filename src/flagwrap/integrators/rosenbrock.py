@@ -28,10 +28,13 @@ class RosenbrockW(AdaptiveMixin, Integrator):
     def __init__(self, tol=None, *, tableau: T.RosenbrockTableau | None = None, **kw):
         if tableau is not None:
             self.tableau = tableau
-        tb = self.tableau
-        self.default_tol, self.default_filter = tb.default_tol, tb.filter_error
-        self.order, self.name = tb.order, tb.name
         super().__init__(tol, **kw)
+
+    # what the scheme is comes from its tableau
+    order = property(lambda self: self.tableau.order)
+    name = property(lambda self: self.tableau.name)
+    default_tol = property(lambda self: self.tableau.default_tol)
+    default_filter = property(lambda self: self.tableau.filter_error)
 
     def step(self, system, y, base, info, h, omega) -> StepResult:
         tb = self.tableau
@@ -74,7 +77,6 @@ class ROS34PW2(RosenbrockW):
     """4 stages, order 3, L-stable, embedded order 2 (:data:`tableau.ROS34PW2`); the default."""
 
     tableau = T.ROS34PW2
-    order, name = 3, "ros34pw2"
 
 
 class ROS2(RosenbrockW):
@@ -82,4 +84,3 @@ class ROS2(RosenbrockW):
     (:data:`tableau.ROS2`)."""
 
     tableau = T.ROS2
-    order, name = 2, "ros2"
