@@ -35,19 +35,15 @@ def boundary_table(sweep_dir) -> list[dict]:
     """Per mismatch (sorted): ``density_mismatch``, ``gravity_number``, ``machin_c``,
     ``m_lo``, ``m_hi`` (None where one-sided) and ``kind`` ("bracket", "upper": buckled at
     every M tried, "lower": stable at every M tried) from a boundary sweep's summaries."""
+    from flagwrap.sweep.boundary import summary_bracket
     from flagwrap.sweep.store import SweepStore
 
     out = []
     for b in SweepStore(sweep_dir).boundaries():
         if b.get("density_mismatch") is None:
             continue
-        lo, hi = (b.get("bracket") or [None, None])[:2]
-        lo = lo if lo is not None and math.isfinite(lo) else None
-        hi = hi if hi is not None and math.isfinite(hi) else None
-        kind = "bracket" if lo is not None and hi is not None else ("upper" if hi is not None else "lower")
         out.append({"density_mismatch": b["density_mismatch"], "gravity_number": b.get("gravity_number"),
-                    "machin_c": b.get("machin_c") if kind == "bracket" else None,
-                    "m_lo": lo, "m_hi": hi, "kind": kind, "converged": b.get("converged"),
+                    **summary_bracket(b), "converged": b.get("converged"),
                     "monotone": b.get("monotone"), "status": b.get("status"),
                     "psi_deg": b["psi_deg"], "turns": b["turns"], "r_over_l": b["r_over_l"]})
     return sorted(out, key=lambda r: (r["psi_deg"], r["turns"], r["density_mismatch"]))

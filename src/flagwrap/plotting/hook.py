@@ -32,17 +32,14 @@ def _helix(r) -> tuple:
 def boundary_table(sweep_dir=BOUNDARY_SWEEP) -> list[dict]:
     """Per helix and joint: ``machin_c`` (None unless bracketed), ``m_lo``, ``m_hi``, ``kind``,
     and the states of the search's test runs (``runs``: machin, buckled, state)."""
+    from flagwrap.sweep.boundary import summary_bracket
     from flagwrap.sweep.store import SweepStore
 
     out = []
     for b in SweepStore(sweep_dir).boundaries():
-        lo, hi = (b.get("bracket") or [None, None])[:2]
-        lo = lo if lo is not None and math.isfinite(lo) else None
-        hi = hi if hi is not None and math.isfinite(hi) else None
-        kind = "bracket" if lo is not None and hi is not None else ("upper" if hi is not None else "lower")
         out.append({"psi_deg": b["psi_deg"], "turns": b["turns"], "r_over_l": b["r_over_l"],
-                    "hook_stiffness": b.get("hook_stiffness"), "machin_c": b.get("machin_c") if kind == "bracket" else None,
-                    "m_lo": lo, "m_hi": hi, "kind": kind, "status": b.get("status"),
+                    "hook_stiffness": b.get("hook_stiffness"), **summary_bracket(b),
+                    "status": b.get("status"),
                     "runs": sorted(b.get("runs") or [], key=lambda r: r["machin"])})
     return sorted(out, key=lambda r: (_helix(r), -(r["hook_stiffness"] or math.inf)))
 

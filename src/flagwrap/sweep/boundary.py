@@ -88,6 +88,18 @@ def run_geometry(case: Case, root, boundary: dict) -> dict:
     return out
 
 
+def summary_bracket(summary: dict) -> dict:
+    """``m_lo``, ``m_hi`` (None where not finite), ``kind`` ("bracket"; "upper": buckled at
+    every M tried; "lower": stable at every M tried) and ``machin_c`` (None unless bracketed)
+    of one boundary search's stored summary."""
+    lo, hi = (summary.get("bracket") or [None, None])[:2]
+    lo = lo if lo is not None and math.isfinite(lo) else None
+    hi = hi if hi is not None and math.isfinite(hi) else None
+    kind = "bracket" if lo is not None and hi is not None else ("upper" if hi is not None else "lower")
+    return {"m_lo": lo, "m_hi": hi, "kind": kind,
+            "machin_c": summary.get("machin_c") if kind == "bracket" else None}
+
+
 GEOMETRY_COLUMNS = ("psi_deg", "turns", "r_over_l", "r_over_rcell", "hi", "n_beads",
                     "ccw_turns", "cw_turns", "density_mismatch", "hook_stiffness")
 #: values of columns that rows written before the column existed lack
