@@ -13,6 +13,9 @@ joint, the body contact, gravity) and then every interaction in ``system.interac
   only the step size can suffer where the term is stiff);
 * ``nonlocal_hessian``: true when the triplets couple beads far apart along the chain (the
   banded solvers, whose band is fixed per system, leave those out; dense and Krylov use them);
+* ``rotation_invariant``: true when ``U`` is unchanged by a rotation of everything about the
+  motor axis (distances only, or axisymmetric fields); the rotating frame
+  (:mod:`flagwrap.system.rotating`) and the stability tool refuse an interaction without it;
 * ``name``: a label for messages and energies.
 
 The Jacobian's motor-angle column omits interactions (the joint's beads move with ``phi``, an
@@ -30,6 +33,7 @@ class Interaction:
 
     name = "interaction"
     nonlocal_hessian = False
+    rotation_invariant = False
 
     def energy_grad(self, x, theta, grad_x, grad_theta) -> float:  # pragma: no cover
         raise NotImplementedError

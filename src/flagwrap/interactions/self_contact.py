@@ -267,6 +267,7 @@ class SelfContactInteraction:
 
     name = "self_contact"
     nonlocal_hessian = True  # pairs far apart along the chain: not in banded solvers' W
+    rotation_invariant = True  # depends on distances only (the rotating frame may use it)
 
     def __init__(self, contact: SelfContact):
         self.contact = contact

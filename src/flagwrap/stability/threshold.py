@@ -1,0 +1,215 @@
+"""The critical Machin number from linear stability: where the steady whirling state of one
+motor direction first becomes unstable.
+
+The steady state is followed in ``M`` from a small value, where it is the rest shape barely
+bent, by Newton continuation (:mod:`flagwrap.stability.steady`: secant predictor in ``log M``,
+the step halved where Newton fails). At every point the leading eigenvalue of the
+turning-frame Jacobian is computed (:mod:`flagwrap.stability.spectrum`). Once its real part
+changes sign, the interval is bisected in ``log M`` to ``rtol``, and ``M_c`` is the root of
+the real part's linear interpolation across the last interval.
+
+The crossing is a **Hopf** bifurcation in the turning frame when the eigenvalue crossing zero
+is a complex pair. Its imaginary part ``Omega`` is the frequency at which the critical mode
+oscillates in that frame, in units of the motor speed; a mode with azimuthal wavenumber ``m``
+appears in the lab at ``m omega +- Omega``. The crossing is **steady** (a real eigenvalue) when
+the pair is real. That means a pitchfork or a fold of the branch, with a new steadily turning
+shape. If the branch cannot be continued (Newton fails at every step down to a factor
+1.001), the result says where it ended: that is a fold of the branch, or a turn too sharp to
+follow.
+
+This is not the time-domain criterion of :mod:`flagwrap.analysis.critical` (the free end
+rising 0.15 L within ``K`` CW turns after ``K'`` CCW turns). That one needs a finite
+perturbation and a finite time. docs/stability.md compares the two.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from flagwrap.stability.spectrum import spectrum
+from flagwrap.stability.steady import NewtonFailure, extrapolate, initial_guess, newton
+
+DIRECTIONS = {"ccw": 1.0, "cw": -1.0}
+
+
+@dataclass
+class BranchPoint:
+    """One steady state on the branch: ``M``, its two leading eigenvalues (units of omega),
+    the free end's axial position ``tip_z`` [L] (rest: ``tip_z0``), the Newton residual."""
+
+    machin: float
+    leading: complex
+    second: complex
+    tip_z: float
+    residual: float
+    iterations: int
+
+    def as_dict(self) -> dict:
+        return {"machin": self.machin, "leading_re": self.leading.real,
+                "leading_im": abs(self.leading.imag), "second_re": self.second.real,
+                "second_im": abs(self.second.imag), "tip_z": self.tip_z,
+                "residual": self.residual, "iterations": self.iterations}
+
+
+@dataclass
+class StabilityResult:
+    """The outcome of :func:`find_critical` (core units unless named SI)."""
+
+    direction: str
+    converged: bool
+    message: str
+    machin_c: float = math.nan
+    bracket: tuple = (math.nan, math.nan)
+    crossing: str = ""  # "hopf" or "steady"
+    eigenvalue: complex = complex(math.nan, math.nan)  # at the upper end of the bracket
+    mode_frequency: float = math.nan  # |Im| of the critical pair / omega (turning frame)
+    omega_c: float = math.nan  # SI [rad/s]
+    frequency_c: float = math.nan  # SI [Hz]
+    tip_z0: float = math.nan
+    branch: list = field(default_factory=list)
+    state: object = field(default=None, repr=False)  # steady state at the top of the bracket
+    wall_time: float = 0.0
+
+    def summary(self) -> dict:
+        return {
+            "direction": self.direction, "converged": self.converged, "message": self.message,
+            "machin_c": self.machin_c, "bracket": list(self.bracket), "crossing": self.crossing,
+            "eigenvalue_re": self.eigenvalue.real, "eigenvalue_im": abs(self.eigenvalue.imag),
+            "mode_frequency": self.mode_frequency, "omega_c": self.omega_c,
+            "frequency_c": self.frequency_c,
+            "mode_frequency_si": self.mode_frequency * self.omega_c,
+            "tip_z0": self.tip_z0, "wall_time": self.wall_time,
+            "branch": [p.as_dict() for p in self.branch],
+        }
+
+
+def _point(frame, state):
+    sp = spectrum(frame, state)
+    second = sp.values[1]
+    if sp.values[0].imag != 0.0 and len(sp.values) > 2:  # skip the conjugate partner
+        second = sp.values[2]
+    return BranchPoint(state.machin, sp.leading, complex(second), float(state.info.x[-1, 2]),
+                       state.residual, state.iterations)
+
+
+def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: float = 1.25,
+                  rtol: float = 1e-3, on_point=None, omega_si: float | None = None,
+                  machin_si: float | None = None) -> StabilityResult:
+    """Continue the steady state of ``frame`` (a :class:`~flagwrap.system.rotating.RotatingFrame`)
+    from ``m_start`` up to ``m_max``; return the first loss of stability.
+
+    ``on_point(BranchPoint)`` is called for every state computed (a progress display).
+    ``omega_si`` / ``machin_si``: the config's motor speed [rad/s] and its ``M``, to report
+    ``omega_c = omega_si M_c / machin_si``.
+    """
+    import time
+
+    t0 = time.perf_counter()
+    direction = "ccw" if frame.omega > 0 else "cw"
+    res = StabilityResult(direction, False, "")
+    z, base = initial_guess(frame)
+    res.tip_z0 = float(frame.system.x0[-1, 2])
+
+    def record(state):
+        p = _point(frame, state)
+        res.branch.append(p)
+        if on_point is not None:
+            on_point(p)
+        return p
+
+    # the first state: Newton from the rest shape, at a smaller M if it must
+    cur = None
+    m = float(m_start)
+    for _ in range(8):
+        try:
+            cur = newton(frame, m, z, base)
+            break
+        except NewtonFailure:
+            m /= 2.0
+    if cur is None:
+        res.message = (f"no steady state found from the rest shape at M = {m_start:g} down to "
+                       f"{m * 2:g} (Newton did not converge)")
+        return _done(res, t0)
+    p = record(cur)
+    if p.leading.real >= 0.0:
+        res.message = (f"the steady state is already unstable at M = {cur.machin:.4g} (leading "
+                       f"eigenvalue {p.leading.real:+.3g} {abs(p.leading.imag):+.3g}i): "
+                       f"lower --m-start")
+        return _done(res, t0)
+    prev = None
+    f = factor
+    while cur.machin < m_max * (1 - 1e-12):
+        m_next = min(cur.machin * f, m_max)
+        guess = extrapolate(frame, prev, cur, m_next) if prev is not None else cur.z
+        try:
+            nxt = newton(frame, m_next, guess, cur.base)
+        except NewtonFailure:
+            f = math.sqrt(f)
+            if f < 1.001:
+                res.message = (f"the steady branch could not be continued beyond M = "
+                               f"{cur.machin:.6g} (a fold of the branch or a sharp turn), stable "
+                               f"up to there")
+                res.bracket = (cur.machin, math.nan)
+                return _done(res, t0)
+            continue
+        pn = record(nxt)
+        if pn.leading.real >= 0.0:
+            return _refine(frame, res, cur, p, nxt, pn, rtol, record, t0, omega_si, machin_si)
+        prev, cur, p = cur, nxt, pn
+        f = min(factor, f * f) if nxt.iterations <= 5 else f
+    res.message = f"stable up to M = {m_max:g} (no crossing in the range scanned: raise --m-max)"
+    res.bracket = (cur.machin, math.nan)
+    return _done(res, t0)
+
+
+def _refine(frame, res, lo, plo, hi, phi, rtol, record, t0, omega_si, machin_si):
+    while hi.machin / lo.machin - 1.0 > rtol:
+        mid = math.sqrt(lo.machin * hi.machin)
+        try:
+            st = newton(frame, mid, extrapolate(frame, hi, lo, mid), lo.base)
+        except NewtonFailure:
+            try:
+                st = newton(frame, mid, hi.z, hi.base)
+            except NewtonFailure:
+                break
+        pm = record(st)
+        if pm.leading.real >= 0.0:
+            hi, phi = st, pm
+        else:
+            lo, plo = st, pm
+    a, b = plo.leading.real, phi.leading.real
+    # the root of the real part's linear interpolation in log M across the last interval
+    w = a / (a - b) if b != a else 0.5
+    res.machin_c = math.exp((1 - w) * math.log(lo.machin) + w * math.log(hi.machin))
+    res.bracket = (lo.machin, hi.machin)
+    res.eigenvalue = phi.leading
+    res.crossing = "steady" if phi.leading.imag == 0.0 else "hopf"
+    res.mode_frequency = abs(phi.leading.imag)
+    res.state = hi
+    res.converged = True
+    res.message = "converged"
+    if omega_si is not None and machin_si:
+        res.omega_c = abs(omega_si) * res.machin_c / machin_si
+        res.frequency_c = res.omega_c / (2 * math.pi)
+    return _done(res, t0)
+
+
+def _done(res, t0):
+    import time
+
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
+def critical_from_config(config, direction: str = "cw", **kw) -> StabilityResult:
+    """:func:`find_critical` for a config: its system, turning at the reference speed in
+    ``direction`` ("cw" or "ccw")."""
+    from flagwrap.system.rod_system import RodSystem
+    from flagwrap.system.rotating import RotatingFrame
+
+    system = RodSystem(config)
+    frame = RotatingFrame(system, DIRECTIONS[direction])
+    return find_critical(frame, omega_si=config.omega, machin_si=config.machin, **kw)

@@ -1,0 +1,189 @@
+"""The equations of motion in the frame that turns with the motor.
+
+The lab-frame system (:mod:`flagwrap.system.rod_system`) is
+``dx/dt = Mob(x) G_x``, ``dtheta_j/dt = G_theta_j / zeta_j`` with the motor angle ``phi``
+turning the clamp, ``dphi/dt = omega``. Write every vector in the frame that turns with the
+clamp about the motor axis ``a`` (``x = R(phi) x'``). The energy is invariant under rotations.
+The RPY mobility is covariant, ``Mob(R x) = R Mob(x) R^T``. The cell body is a capped cylinder
+on the axis, and gravity is parallel to it. So in that frame the clamp stands still and the
+equations are autonomous:
+
+    dx'/dt      = Mob(x') G_x(x', theta')  - omega a x x'
+    dtheta'_j/dt = G_theta_j / zeta_j       - omega (a . t'_j)
+
+The twist term comes from the reference frames. In the lab, a bond's reference director is
+transported in time along its moving tangent (no twist about ``t``). Seen from the turning
+frame, that director turns about ``t'`` at ``-omega (a . t')`` relative to one transported in
+the turning frame. So an angle measured from the turning frame's own transported director
+changes by that much less (derivation in docs/stability.md). The clamped bond obeys the same
+rule: in the lab it turns at ``twist_rate = a . t_0`` per radian of ``phi``
+(:class:`~flagwrap.joints.clamp.AxialClamp`), and in the turning frame it is fixed.
+
+A steadily whirling helix is a fixed point of these equations. It can be found by Newton and
+its linear stability read from their Jacobian (:mod:`flagwrap.stability`). The Jacobian is
+taken in the chart whose reference frames are those of the point itself. A chart change
+alters the reference director's twist only at second order in the displacement, so the
+linearisation is the same in every chart.
+
+``omega`` and ``M`` are in core units (time ``1/omega_ref``): ``omega = +-speed``. The mobility
+scales as ``1/M`` for translation and twist alike, so one system built at ``M_0`` serves every
+``M`` through the factor ``M_0 / M``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flagwrap.errors import UserInputError
+
+
+def cross_matrix(a) -> np.ndarray:
+    """``[a]_x`` with ``[a]_x v = a x v``."""
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+def check_rotating_frame(system) -> None:
+    """Refuse a system whose equations are not autonomous in the turning frame (one line,
+    naming the part that breaks the symmetry about the motor axis)."""
+    joint = system.joint
+    axis = getattr(joint, "axis", None)
+    if axis is None or not hasattr(joint, "x_ref"):
+        raise UserInputError(
+            f"the rotating frame needs a joint that turns rigidly about the motor axis; "
+            f"{type(joint).__name__} does not (use [joint] kind = \"clamp\" or \"hook\")")
+    a = np.asarray(axis, float)
+    ez = np.array([0.0, 0.0, 1.0])
+    if np.linalg.norm(np.cross(a, ez)) > 1e-12:
+        # the capped cylinder and gravity are along z: the motor axis must be too
+        raise UserInputError("the rotating frame needs the motor axis along the body axis z")
+    g = np.asarray(system.gravity)
+    if np.any(np.abs(g[:, :2]) > 0.0):
+        raise UserInputError("the rotating frame needs gravity along the motor axis")
+    for it in system.interactions:
+        if not getattr(it, "rotation_invariant", False):
+            raise UserInputError(
+                f"the rotating frame needs every interaction to be invariant under rotations "
+                f"about the motor axis; {getattr(it, 'name', type(it).__name__)!r} does not say "
+                f"it is (set rotation_invariant = True on it if it is)")
+    if getattr(system.body, "pose", None) is not None:
+        raise UserInputError("the rotating frame needs a fixed, axisymmetric cell body")
+
+
+class RotatingFrame:
+    """The system's equations in the frame turning with the motor at ``omega`` (core units).
+
+    The unknowns are ``z = y[:-1]``, the lab state vector without the motor angle, written in
+    the turning frame. The clamp is then at its reference position (``phi = 0``).
+    """
+
+    def __init__(self, system, omega: float):
+        check_rotating_frame(system)
+        if system.i_phi != system.ny - 1:
+            raise ValueError("RotatingFrame: the motor angle must be the last unknown")
+        self.system = system
+        self.omega = float(omega)
+        self.axis = np.asarray(system.joint.axis, float)
+        self.n = system.ny - 1
+        self.n3 = 3 * system.nb
+        self._A = cross_matrix(self.axis)
+
+    def full(self, z) -> np.ndarray:
+        """The lab state vector at ``phi = 0`` (where both frames coincide)."""
+        y = np.empty(self.system.ny)
+        y[:-1] = z
+        y[-1] = 0.0
+        return y
+
+    def lab_to_rotating(self, y, base):
+        """``(z, base')`` of a lab state at motor angle ``y[-1]``: positions and reference
+        directors turned back by ``phi``; the twist angles are unchanged (they are measured
+        from the turned directors)."""
+        s = self.system
+        phi = float(y[s.i_phi])
+        R = rotation(self.axis, -phi)
+        z = np.array(y[:-1], float)
+        xs = z[s.sl_x].reshape(-1, 3) @ R.T
+        z[s.sl_x] = xs.ravel()
+        from flagwrap.elasticity.rod import Frames
+
+        return z, Frames(base.t @ R.T, base.d1 @ R.T, base.rt.copy())
+
+    def scale(self, machin: float | None) -> float:
+        return 1.0 if machin is None else self.system.machin / float(machin)
+
+    def velocity(self, z, base, machin: float | None = None):
+        """``dz/dt`` (turning frame) and the :class:`ForceInfo` at ``z``; ``machin``: the
+        Machin number to use (default: the system's)."""
+        s = self.system
+        y = self.full(z)
+        info = s.forces(y, base)
+        f = s.apply_mobility(y, info.G)[:-1]
+        f *= self.scale(machin)
+        x = info.x[s.nc:]
+        f[: self.n3] -= self.omega * np.cross(self.axis, x).ravel()
+        f[self.n3:] -= self.omega * (info.frames.t[s.ec:] @ self.axis)
+        return f, info
+
+    def jacobian(self, z, base, machin: float | None = None, info=None) -> np.ndarray:
+        """``d(dz/dt)/dz`` (n, n), dense, at ``z`` in the chart of ``base``.
+
+        ``Mob (dG/dz) + (dMob/dx)[G] - omega (d rotation terms)``. ``dG/dz``: the system's
+        Jacobian (exact stretching Hessian, the interactions' Hessians, coloured differences
+        of the rest) averaged over steps ``+delta`` and ``-delta``. That makes its difference
+        part central, second-order accurate. ``(dMob/dx)[G]``: central differences of the
+        mobility product at fixed forces. The rotation terms are exact.
+        """
+        s = self.system
+        y = self.full(z)
+        if info is None:
+            info = s.forces(y, base)
+        n, n3 = self.n, self.n3
+        d = s.fd_step
+        JG = 0.5 * (s.force_jacobian(y, base, info.G, delta=d)
+                    + s.force_jacobian(y, base, info.G, delta=-d))
+        Mxx, mt = s.mobility_blocks(y)
+        sc = self.scale(machin)
+        J = np.empty((n, n))
+        J[:n3] = Mxx @ JG[:n3, :n]
+        J[n3:] = mt[:, None] * JG[n3:n, :n]
+        # (dMob/dx)[G]: the mobility at fixed forces, differenced bead by bead
+        if s.mobility.long_range:
+            xf = np.ascontiguousarray(info.x[s.nc:])
+            F = np.ascontiguousarray(info.G[:n3].reshape(-1, 3))
+            h = 1e-4 * s.bond  # the mobility varies on the bead radius: (h/a)^2 ~ 1e-7
+            xp = xf.copy()
+            for k in range(n3):
+                i, c = divmod(k, 3)
+                xp[i, c] = xf[i, c] + h
+                vp = s.mobility.apply(xp, F)
+                xp[i, c] = xf[i, c] - h
+                vm = s.mobility.apply(xp, F)
+                xp[i, c] = xf[i, c]
+                J[:n3, k] += (vp - vm).ravel() / (2.0 * h * s.machin)
+        J *= sc
+        om = self.omega
+        for i in range(s.nb):  # - omega a x x'
+            J[3 * i:3 * i + 3, 3 * i:3 * i + 3] -= om * self._A
+        # - omega a . t_j: d t_j / d x_{j+1} = (I - t t) / l_j = -d t_j / d x_j
+        x = info.x
+        a = self.axis
+        for j in range(s.ec, s.N - 1):
+            e = x[j + 1] - x[j]
+            ln = np.linalg.norm(e)
+            t = e / ln
+            g = (a - (a @ t) * t) / ln
+            r = n3 + (j - s.ec)
+            if j + 1 >= s.nc:
+                k = 3 * (j + 1 - s.nc)
+                J[r, k:k + 3] -= om * g
+            if j >= s.nc:
+                k = 3 * (j - s.nc)
+                J[r, k:k + 3] += om * g
+        return J
+
+
+def rotation(axis, angle: float) -> np.ndarray:
+    """Rotation matrix by ``angle`` about the unit vector ``axis`` (right-handed)."""
+    a = np.asarray(axis, float)
+    K = cross_matrix(a)
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
