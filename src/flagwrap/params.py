@@ -555,6 +555,13 @@ class Numerics:
         output interval [turns].
     max_steps : int
         hard cap on the number of steps.
+    frame : {"lab", "rotating"}
+        the frame the equations are stepped in (:mod:`flagwrap.system.rotating`). "lab"
+        (default, the reference): the clamp turns. "rotating": the frame turns with the motor,
+        so a steadily whirling helix stands still and the step grows to the output interval
+        (docs/stability.md measures the speed-up and the accuracy). Run files are in the lab
+        frame either way. It needs a system symmetric about the motor axis (every system
+        flagwrap builds today is).
     """
 
     integrator: str = "ros34pw2"
@@ -569,10 +576,12 @@ class Numerics:
     mobility_tol: float = 1e-10
     linear_solver: str = "auto"
     max_wall_time: float = 0.0
+    frame: str = "lab"
 
-    # performance options left out of result keys at their defaults (Config.to_dict(for_hash))
+    # options left out of result keys at their defaults (Config.to_dict(for_hash)): added
+    # after results were stored, their defaults are what those results used
     HASH_OMIT_DEFAULTS = {"mobility_backend": "auto", "mobility_tol": 1e-10, "linear_solver": "auto",
-                          "max_wall_time": 0.0}
+                          "max_wall_time": 0.0, "frame": "lab"}
 
     def __post_init__(self):
         from flagwrap.hydrodynamics.mobility import BACKENDS, backend_missing
@@ -598,6 +607,8 @@ class Numerics:
             raise UserInputError(f"numerics.linear_solver = {self.linear_solver!r} needs "
                                  "numerics.hydrodynamics = false (it is exact only for a local "
                                  "mobility); use 'auto'")
+        if self.frame not in ("lab", "rotating"):
+            raise UserInputError(f"numerics.frame must be 'lab' or 'rotating', got {self.frame!r}")
         if self.integrator not in ("ros34pw2", "ros2", "euler"):
             raise UserInputError(
                 "numerics.integrator must be 'ros34pw2', 'ros2' or 'euler', "

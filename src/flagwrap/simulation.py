@@ -93,7 +93,7 @@ class Simulation:
         self.checkpoint_every_steps = int(checkpoint_every_steps or 0)
         self.checkpoint_every_seconds = float(checkpoint_every_seconds or 0.0)
         self._config_toml = None
-        self.system = system or RodSystem(config)
+        self.system = system or make_system(config)
         num = config.numerics
         self.integrator = integrator or make_integrator(num.integrator, num.tol, num.linear_solver)
         self.h0 = num.dt * TWO_PI
@@ -105,6 +105,7 @@ class Simulation:
 
     def _record(self, traj, t, y, info, omega):
         s = self.system
+        info = s.record_view(y, info)  # the lab frame (a turning-frame system rotates it back)
         m1 = np.empty((s.N - 1, 3))
         m2 = np.empty((s.N - 1, 3))
         from flagwrap.elasticity._kernels import material_frames
@@ -438,6 +439,17 @@ class RunInterrupted(KeyboardInterrupt):
     def __init__(self, trajectory):
         super().__init__(trajectory.message)
         self.trajectory = trajectory
+
+
+def make_system(config):
+    """The config's system: a :class:`RodSystem`, stepped in the turning frame when
+    ``numerics.frame = "rotating"`` (:class:`flagwrap.system.rotating.RotatingSystem`)."""
+    system = RodSystem(config)
+    if config.numerics.frame == "rotating":
+        from flagwrap.system.rotating import RotatingSystem
+
+        system = RotatingSystem(system)
+    return system
 
 
 def simulate(config, progress: bool = False, resume=None, **kwargs) -> Trajectory:

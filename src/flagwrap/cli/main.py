@@ -27,6 +27,7 @@ COMMANDS: dict[str, str] = {
     "export-vtk": "export_vtk",
     "figure": "figure",
     "critical": "critical",
+    "stability": "stability",
     "sweep": "sweep",
 }
 

@@ -18,8 +18,7 @@ class ExplicitEuler(Integrator):
     name = "euler"
 
     def step(self, system, y, base, info, h, omega) -> StepResult:
-        f = system.apply_mobility(y, info.G)
-        f[system.i_phi] = omega
+        f = system.velocity(y, info, omega)
         y_new = y + h * f
         if not np.all(np.isfinite(y_new)):
             return StepResult(False, None, None, h, np.nan, "non-finite state")

@@ -50,8 +50,7 @@ class RosenbrockW(AdaptiveMixin, Integrator):
         U = np.empty((tb.stages, system.ny))
         for i in range(tb.stages):
             if i == 0:
-                f = system.apply_mobility(y, info.G)
-                f[system.i_phi] = omega
+                f = system.velocity(y, info, omega)
             else:
                 Yi = y + a[i, :i] @ U[:i]
                 if not np.all(np.isfinite(Yi)):

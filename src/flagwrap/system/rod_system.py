@@ -262,11 +262,20 @@ class RodSystem:
         out[self.i_phi] = 0.0
         return out
 
-    def rhs(self, y, base, omega):
-        info = self.forces(y, base)
+    def velocity(self, y, info: ForceInfo, omega: float) -> np.ndarray:
+        """``dy/dt`` at ``y`` from the forces ``info`` already computed there."""
         f = self.apply_mobility(y, info.G)
         f[self.i_phi] = omega
-        return f, info
+        return f
+
+    def rhs(self, y, base, omega):
+        info = self.forces(y, base)
+        return self.velocity(y, info, omega), info
+
+    def record_view(self, y, info: ForceInfo) -> ForceInfo:
+        """The forces and geometry at ``y`` as the run file records them (the lab frame;
+        here ``info`` itself)."""
+        return info
 
     def local_mobility_diagonal(self) -> np.ndarray:
         """Diagonal of the self (no-HI) mobility in core units, (ny,); 0 for the motor angle."""

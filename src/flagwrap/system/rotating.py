@@ -187,3 +187,87 @@ def rotation(axis, angle: float) -> np.ndarray:
     a = np.asarray(axis, float)
     K = cross_matrix(a)
     return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
+
+
+class RotatingSystem:
+    """A :class:`~flagwrap.system.rod_system.RodSystem` stepped in the frame turning with its
+    motor (``numerics.frame = "rotating"``).
+
+    The state vector keeps the lab layout, motor angle included (``dphi/dt = omega``, the
+    angle of the frame). Its positions and reference frames are in the turning frame. The forces are
+    evaluated with the clamp at ``phi = 0``, and the velocity gains the terms of the module
+    docstring. Everything else (layout, mobility blocks, Jacobian triplets) is the lab
+    system's: the rotation terms are not stiff (rate ``omega``), so ``W`` leaves them out, and
+    the W-methods keep their order for such a ``W``. The Jacobian's motor-angle column is
+    dropped: in this frame no force depends on the motor angle. :meth:`record_view` turns a
+    state back to the lab frame for the run file.
+    """
+
+    def __init__(self, system):
+        check_rotating_frame(system)
+        self.inner = system
+        self.axis = np.asarray(system.joint.axis, float)
+        self._y0 = np.empty(system.ny)
+
+    def __getattr__(self, name):  # everything not overridden is the lab system's
+        return getattr(self.inner, name)
+
+    def _at_zero(self, y) -> np.ndarray:
+        y0 = np.array(y, float)
+        y0[self.inner.i_phi] = 0.0
+        return y0
+
+    def unpack(self, y):
+        x, theta, _ = self.inner.unpack(self._at_zero(y))
+        return x, theta, float(y[self.inner.i_phi])
+
+    def forces(self, y, base):
+        return self.inner.forces(self._at_zero(y), base)
+
+    def velocity(self, y, info, omega: float) -> np.ndarray:
+        s = self.inner
+        f = s.apply_mobility(y, info.G)
+        if omega != 0.0:
+            f[s.sl_x] -= omega * np.cross(self.axis, info.x[s.nc:]).ravel()
+            f[s.sl_th] -= omega * (info.frames.t[s.ec:] @ self.axis)
+        f[s.i_phi] = omega
+        return f
+
+    def rhs(self, y, base, omega):
+        info = self.forces(y, base)
+        return self.velocity(y, info, omega), info
+
+    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
+        r, c, v = self.inner.force_jacobian_coo(self._at_zero(y), base, G0, delta, nonlocal_terms)
+        keep = c != self.inner.i_phi
+        return r[keep], c[keep], v[keep]
+
+    def force_jacobian(self, y, base, G0=None, delta=None):
+        from flagwrap.system import kernels as SK
+
+        rows, cols, vals = self.force_jacobian_coo(y, base, G0, delta)
+        J = np.zeros((self.inner.ny, self.inner.ny))
+        SK.scatter_dense(rows, cols, vals, J)
+        return J
+
+    def force_jacobian_sparse(self, y, base, G0=None, delta=None):
+        import scipy.sparse as sp
+
+        rows, cols, vals = self.force_jacobian_coo(y, base, G0, delta)
+        n = self.inner.ny
+        return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+    def interaction_jacobian_coo(self, y, which: str = "all"):
+        return self.inner.interaction_jacobian_coo(self._at_zero(y), which)
+
+    def record_view(self, y, info):
+        """``info`` with its positions, gradients and reference frames turned by the motor
+        angle into the lab frame (twist angles and energies are frame-independent)."""
+        import dataclasses
+
+        from flagwrap.elasticity.rod import Frames
+
+        R = rotation(self.axis, float(y[self.inner.i_phi]))
+        fr = info.frames
+        return dataclasses.replace(info, x=info.x @ R.T, grad_x=info.grad_x @ R.T,
+                                   frames=Frames(fr.t @ R.T, fr.d1 @ R.T, fr.rt))

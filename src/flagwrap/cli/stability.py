@@ -1,0 +1,174 @@
+"""Critical Machin number M_c from linear stability: steady whirl, eigenvalues, crossing type.
+
+The steady state of the config's helix turning at constant speed (a fixed point in the frame
+that turns with the motor) is followed in M by Newton continuation from M_START. The
+eigenvalues of its Jacobian are computed along the way, and M_c is where the leading one
+first crosses zero. Prints M_c, omega_c (SI), the crossing type (Hopf: a complex pair, with
+its frequency in the turning frame; steady: a real eigenvalue) and the steady shape at M_c.
+The config's motor protocol and M are not used; its geometry, fluid, body, joint and
+numerics.hydrodynamics are. Method and validation: docs/stability.md.
+
+Exit status: 0 found, 1 no crossing in the range or the branch lost (what was found is
+printed), 2 bad input.
+
+Examples::
+
+    flagwrap stability examples/fig4a.toml
+    flagwrap stability examples/fig4a.toml --direction ccw --m-max 3000 --json
+    flagwrap stability examples/movie7.toml --mode out/movie7_mode.png --vtk out/movie7_mode.vtp
+"""
+
+from __future__ import annotations
+
+import math
+
+
+def add_arguments(p):
+    p.add_argument("config", metavar="CONFIG.toml", help="geometry/fluid/numerics (its M and protocol are not used)")
+    p.add_argument("--direction", choices=["cw", "ccw"], default="cw",
+                   help="motor direction of the steady state (cw: the buckling one; default)")
+    p.add_argument("--m-start", type=float, default=10.0, help="first M of the continuation (10)")
+    p.add_argument("--m-max", type=float, default=None,
+                   help="last M (default: 20x the scaling line 0.06 (R/L)^-3)")
+    p.add_argument("--rtol", type=float, default=1e-3, help="relative width of the final M bracket (1e-3)")
+    p.add_argument("--factor", type=float, default=1.25, help="largest continuation step in M (x1.25)")
+    p.add_argument("--no-hi", action="store_true", help="switch hydrodynamic interactions off")
+    p.add_argument("--mode", default=None, metavar="FILE.png", help="plot the steady shape and the critical mode")
+    p.add_argument("--vtk", default=None, metavar="FILE.vtp",
+                   help="write the steady shape at M_c with the critical mode as point data (ParaView)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def check_options(args) -> None:
+    """Every option's range before any work (one-line errors naming the option)."""
+    from flagwrap.errors import UserInputError
+    from flagwrap.io.outputs import check_output_file
+
+    def number(name, v, lo, hi, lo_open=True):
+        if v is None:
+            return
+        if not math.isfinite(v) or (v <= lo if lo_open else v < lo) or v > hi:
+            raise UserInputError(f"{name} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}], got {v:g}")
+
+    number("--m-start", args.m_start, 0.0, 1e7)
+    number("--m-max", args.m_max, 0.0, 1e8)
+    if args.m_max is not None and not args.m_max > args.m_start:
+        raise UserInputError(f"--m-max must be above --m-start ({args.m_start:g}), got {args.m_max:g}")
+    number("--rtol", args.rtol, 0.0, 0.5)
+    number("--factor", args.factor, 1.001, 4.0, lo_open=False)
+    if args.mode is not None:
+        check_output_file(args.mode, "--mode", {".png", ".pdf", ".svg"})
+    if args.vtk is not None:
+        check_output_file(args.vtk, "--vtk", {".vtp"})
+
+
+def _bar(enabled, m_start, m_max):
+    if not enabled:
+        return None
+    from tqdm.auto import tqdm
+
+    return tqdm(total=round(math.log(m_max / m_start), 3), unit="ln M", desc="stability",
+                bar_format="{l_bar}{bar}| M = {postfix[0]:.4g} [{elapsed}]", postfix=[m_start])
+
+
+def run(args) -> int:
+    import dataclasses
+    import json
+    import sys
+
+    from flagwrap.io.config import load_config
+    from flagwrap.stability.threshold import DIRECTIONS, find_critical
+    from flagwrap.system.rod_system import RodSystem
+    from flagwrap.system.rotating import RotatingFrame
+
+    check_options(args)
+    cfg = load_config(args.config)
+    if args.no_hi:
+        cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
+    m_max = args.m_max if args.m_max is not None else 20.0 * cfg.machin_critical_scaling
+    if not m_max > args.m_start:
+        from flagwrap.errors import UserInputError
+
+        raise UserInputError(f"--m-max must be above --m-start ({args.m_start:g}); the default "
+                             f"20x the scaling line is {m_max:g} here: give --m-max")
+    frame = RotatingFrame(RodSystem(cfg), DIRECTIONS[args.direction])  # refuses a bad system
+    bar = _bar(not (args.json or args.no_progress) and sys.stderr.isatty(), args.m_start, m_max)
+
+    def show(p):
+        if bar is not None:
+            bar.postfix[0] = p.machin
+            bar.n = round(min(bar.total, max(0.0, math.log(p.machin / args.m_start))), 3)
+            bar.refresh()
+
+    try:
+        res = find_critical(frame, m_start=args.m_start, m_max=m_max, factor=args.factor,
+                            rtol=args.rtol, on_point=show, omega_si=cfg.omega,
+                            machin_si=cfg.machin)
+    finally:
+        if bar is not None:
+            bar.close()
+    files = _write_mode(frame, res, cfg, args)
+    s = res.summary()
+    s.update(config=str(args.config), hydrodynamics=cfg.numerics.hydrodynamics,
+             machin_critical_scaling=cfg.machin_critical_scaling, m_start=args.m_start,
+             m_max=m_max, files=files)
+    if args.json:
+        from flagwrap.sweep.store import jsonable
+
+        print(json.dumps(jsonable(s), sort_keys=True, allow_nan=False))
+        return 0 if res.converged else 1
+    L = cfg.filament.length
+    print(f"{args.config}: linear stability of the steady {args.direction.upper()} whirl "
+          f"(HI {'on' if cfg.numerics.hydrodynamics else 'off'}), M from {args.m_start:g} to "
+          f"{m_max:.4g}: {len(res.branch)} steady states, {res.wall_time:.1f} s")
+    if not res.converged:
+        print(f"NOT FOUND: {res.message}")
+        return 1
+    lo, hi = res.bracket
+    lam = res.eigenvalue
+    print(f"M_c     = {res.machin_c:.2f}  (bracket {lo:.2f} .. {hi:.2f})")
+    print(f"omega_c = {res.omega_c:.5g} rad/s  (f_c = {res.frequency_c:.5g} Hz)")
+    if res.crossing == "hopf":
+        print(f"crossing: Hopf; critical pair {lam.real:+.2e} +- {abs(lam.imag):.4f}i omega at "
+              f"M = {hi:.2f}: in the turning frame the mode oscillates at {res.mode_frequency:.4f} "
+              f"omega_c = {res.mode_frequency * res.omega_c:.4g} rad/s")
+    else:
+        print(f"crossing: steady (real eigenvalue {lam.real:+.2e} omega at M = {hi:.2f}): a new "
+              f"steadily turning shape branches off, or the branch folds")
+    tip = res.state.info.x[-1, 2] if res.state is not None else math.nan
+    print(f"steady shape at M_c: free end {(tip - res.tip_z0):+.4f} L above its rest height "
+          f"({(tip - res.tip_z0) * L * 1e3:+.3g} mm)")
+    print(f"M_c / scaling line 0.06 (R/L)^-3 = {res.machin_c / cfg.machin_critical_scaling:.2f}")
+    for f in files:
+        print(f"wrote {f}")
+    return 0
+
+
+def _write_mode(frame, res, cfg, args) -> list:
+    """The optional plot and VTK file of the critical mode (nothing when not converged)."""
+    if res.state is None or not (args.mode or args.vtk):
+        return []
+    import numpy as np
+
+    from flagwrap.stability.spectrum import mode_positions, spectrum
+
+    sp = spectrum(frame, res.state, vectors=True)
+    mode = mode_positions(frame, sp.vectors[:, 0])
+    x = res.state.info.x
+    L = cfg.filament.length
+    files = []
+    if args.vtk:
+        from flagwrap.io.vtk import _write, polydata_xml
+
+        amp = 0.05  # the mode drawn at 0.05 L of largest displacement
+        _write(args.vtk, polydata_xml(x * L, lines=[np.arange(len(x))], point_data={
+            "mode_real": mode.real * amp * L, "mode_imag": mode.imag * amp * L,
+            "mode_amplitude": np.linalg.norm(mode, axis=1)}))
+        files.append(str(args.vtk))
+    if args.mode:
+        from flagwrap.plotting.stability import plot_mode
+
+        plot_mode(x, mode, res, cfg, args.mode)
+        files.append(str(args.mode))
+    return files
