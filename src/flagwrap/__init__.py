@@ -10,8 +10,8 @@ Data flows one way: parameters -> initial state -> stepper(forces, mobility) -> 
 __version__ = "0.1.0"
 
 #: the Python API (flagwrap.api), one function per command, imported on first use
-_API = ("load", "run", "RunResult", "analyze", "critical", "CriticalResult", "sweep", "figure",
-        "bacteria")
+_API = ("load", "run", "RunResult", "analyze", "critical", "CriticalResult", "stability",
+        "sweep", "figure", "bacteria")
 __all__ = ["__version__", *_API]
 
 

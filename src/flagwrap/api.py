@@ -12,6 +12,8 @@ command prints::
     flagwrap.analyze("out/fig4a.nc")["state"]                 # "stable"
     c = flagwrap.critical("examples/fig4a.toml", rtol=0.1)    # CriticalResult
     print(c.machin_c, c.bracket, c.omega_c)
+    s = flagwrap.stability("examples/fig4a.toml")             # StabilityResult (seconds)
+    print(s.machin_c, s.crossing, s.mode_frequency)
     flagwrap.sweep("examples/sweeps/fig5-quick.toml")         # SweepReport
     flagwrap.figure("fig5")                                   # [paths]
     flagwrap.bacteria()                                       # [dict per species]
@@ -165,6 +167,33 @@ def critical(config, rtol: float = 0.05, cw_turns: float = 10.0, ccw_turns: floa
     return CriticalResult(s["machin_c"], tuple(s["bracket"]), s["converged"],
                           s["relative_uncertainty"], s["omega_c"], s["frequency_c"],
                           s["gravity_number"], s["monotone"], s["runs"], s)
+
+
+def stability(config, direction: str = "cw", m_start: float = 10.0, m_max=None,
+              rtol: float = 1e-3, factor: float = 1.25, hydrodynamics=None, on_point=None):
+    """``flagwrap stability``: M_c from the linear stability of the steady whirl
+    (:class:`flagwrap.stability.threshold.StabilityResult`: ``machin_c``, ``bracket``,
+    ``crossing``, ``eigenvalue``, ``mode_frequency``, ``omega_c``, ``branch``, ``summary()``);
+    the option ranges are those of the command."""
+    import argparse
+
+    from flagwrap.cli.stability import check_options
+    from flagwrap.errors import UserInputError
+    from flagwrap.stability.threshold import DIRECTIONS, find_critical
+    from flagwrap.system.rod_system import RodSystem
+    from flagwrap.system.rotating import RotatingFrame
+
+    if direction not in DIRECTIONS:
+        raise UserInputError(f"direction must be 'cw' or 'ccw', got {direction!r}")
+    check_options(argparse.Namespace(m_start=m_start, m_max=m_max, rtol=rtol, factor=factor,
+                                     mode=None, vtk=None))
+    cfg = _with_numerics(load(config), hydrodynamics)
+    m_max = 20.0 * cfg.machin_critical_scaling if m_max is None else m_max
+    if not m_max > m_start:
+        raise UserInputError(f"m_max must be above m_start ({m_start:g}), got {m_max:g}")
+    frame = RotatingFrame(RodSystem(cfg), DIRECTIONS[direction])
+    return find_critical(frame, m_start=m_start, m_max=m_max, factor=factor, rtol=rtol,
+                         on_point=on_point, omega_si=cfg.omega, machin_si=cfg.machin)
 
 
 def sweep(spec, out="out/sweeps", scheduler: str = "local", workers=None,

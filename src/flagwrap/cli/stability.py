@@ -16,6 +16,7 @@ Examples::
     flagwrap stability examples/fig4a.toml
     flagwrap stability examples/fig4a.toml --direction ccw --m-max 3000 --json
     flagwrap stability examples/movie7.toml --mode out/movie7_mode.png --vtk out/movie7_mode.vtp
+    flagwrap stability examples/sweeps/fig5.toml --sweep     # every helix of Fig. 5 -> JSON
 """
 
 from __future__ import annotations
@@ -38,6 +39,13 @@ def add_arguments(p):
                    help="write the steady shape at M_c with the critical mode as point data (ParaView)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    g = p.add_argument_group("a whole diagram")
+    g.add_argument("--sweep", action="store_true",
+                   help="CONFIG is a sweep file (e.g. examples/sweeps/fig5.toml): M_c (CW) of each "
+                        "of its geometries, up to 30x the scaling line, written to --out")
+    g.add_argument("--out", default=None, metavar="FILE.json",
+                   help="result file of --sweep (out/stability/<sweep name>.json)")
+    g.add_argument("--workers", type=int, default=None, help="processes for --sweep (the cores)")
 
 
 def check_options(args) -> None:
@@ -61,6 +69,16 @@ def check_options(args) -> None:
         check_output_file(args.mode, "--mode", {".png", ".pdf", ".svg"})
     if args.vtk is not None:
         check_output_file(args.vtk, "--vtk", {".vtp"})
+    if getattr(args, "workers", None) is not None and not 1 <= args.workers <= 256:
+        raise UserInputError(f"--workers must be in [1, 256], got {args.workers}")
+    if getattr(args, "out", None) is not None:
+        if not getattr(args, "sweep", False):
+            raise UserInputError("--out is the result file of --sweep; without --sweep use --json")
+        check_output_file(args.out, "--out", {".json"})
+    if getattr(args, "sweep", False) and (args.mode or args.vtk or args.direction != "cw"
+                                          or args.m_max is not None):
+        raise UserInputError("--sweep computes the CW threshold of every geometry up to 30x its "
+                             "scaling line: --mode, --vtk, --direction and --m-max do not apply")
 
 
 def _bar(enabled, m_start, m_max):
@@ -83,6 +101,8 @@ def run(args) -> int:
     from flagwrap.system.rotating import RotatingFrame
 
     check_options(args)
+    if getattr(args, "sweep", False):
+        return _run_sweep(args)
     cfg = load_config(args.config)
     if args.no_hi:
         cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
@@ -172,3 +192,62 @@ def _write_mode(frame, res, cfg, args) -> list:
         plot_mode(x, mode, res, cfg, args.mode)
         files.append(str(args.mode))
     return files
+
+
+def _run_sweep(args) -> int:
+    import json
+    import sys
+
+    from flagwrap.stability.boundary import stability_boundary
+    from flagwrap.sweep.spec import load_spec
+    from flagwrap.sweep.store import jsonable, write_json_atomic
+
+    spec = load_spec(args.config)
+    out = args.out or f"out/stability/{spec.name}.json"
+    from flagwrap.io.outputs import check_output_file
+
+    check_output_file(out, "--out", {".json"})
+    bar = None
+    if not (args.json or args.no_progress) and sys.stderr.isatty():
+        from tqdm.auto import tqdm
+
+        from flagwrap.stability.boundary import geometry_configs
+
+        bar = tqdm(total=len(geometry_configs(spec)), unit="helix", desc=f"stability {spec.name}")
+
+    def show(row):
+        if bar is not None:
+            bar.update(1)
+        elif not args.json:
+            print(_row_line(row), flush=True)
+
+    try:
+        res = stability_boundary(spec, workers=args.workers, on_row=show, rtol=args.rtol)
+    finally:
+        if bar is not None:
+            bar.close()
+    res = jsonable(res)
+    write_json_atomic(res, out)
+    if args.json:
+        print(json.dumps(res, sort_keys=True, allow_nan=False))
+    else:
+        if bar is not None:
+            for row in res["rows"]:
+                print(_row_line(row))
+        fit = res["fit"]
+        if "prefactor" in fit:
+            print(f"fit over {fit['n']} helices: M_c = {fit['prefactor']:.3g} (R/L)^-"
+                  f"{fit['exponent']:.3f} +- {fit['exponent_se']:.3f} (rms {fit['rms_ln']:.2f} in "
+                  f"ln M_c); the paper's line: 0.06 (R/L)^-3")
+        print(f"{len(res['rows'])} helices, {res['wall_time_s']:.1f} s on {res['workers']} "
+              f"processes; wrote {out}")
+    return 0 if all(r["converged"] for r in res["rows"]) else 1
+
+
+def _row_line(row) -> str:
+    mc = row.get("machin_c")
+    head = f"  psi = {row['psi_deg']:5.1f} deg, n = {row['turns']:3.1f}, R/L = {row['r_over_l']:.4f}: "
+    if mc is None:
+        return head + row["message"]
+    return head + (f"M_c = {mc:8.1f} ({row['crossing']}, Omega = {row['mode_frequency']:.3f} omega), "
+                   f"{row['ratio_to_scaling']:.2f}x the scaling line")

@@ -72,17 +72,23 @@ def spectrum(frame, state, vectors: bool = False, method: str = "auto", k: int =
     raise ValueError(f"method must be 'auto', 'dense' or 'arnoldi', got {method!r}")
 
 
+def mode_vector(frame, vector: np.ndarray) -> np.ndarray:
+    """A mode as a complex vector over the unknowns ``z``, scaled to a largest bead
+    displacement of 1 with that bead's displacement as real as a complex vector can be."""
+    v = np.asarray(vector, complex)
+    d = v[: frame.n3].reshape(-1, 3)
+    amp = np.linalg.norm(d, axis=1)
+    i = int(np.argmax(amp)) if amp.size else 0
+    if not amp.size or amp[i] == 0:
+        return v
+    ph = np.angle(np.sum(d[i] * d[i])) / 2.0
+    return v * np.exp(-1j * ph) / amp[i]
+
+
 def mode_positions(frame, vector: np.ndarray) -> np.ndarray:
-    """The position part of a mode as ``(N, 3)`` complex displacements (zero on the clamped
-    beads), normalised to a largest bead displacement of 1 with that bead's phase real."""
+    """The position part of :func:`mode_vector` as ``(N, 3)`` complex displacements (zero on
+    the clamped beads)."""
     s = frame.system
     d = np.zeros((s.N, 3), complex)
-    d[s.nc:] = np.asarray(vector)[: frame.n3].reshape(-1, 3)
-    amp = np.linalg.norm(d, axis=1)
-    i = int(np.argmax(amp))
-    if amp[i] == 0:
-        return d
-    # phase that makes the largest displacement vector as real as possible
-    v = d[i]
-    ph = np.angle(np.sum(v * v)) / 2.0
-    return d * np.exp(-1j * ph) / amp[i]
+    d[s.nc:] = mode_vector(frame, vector)[: frame.n3].reshape(-1, 3)
+    return d

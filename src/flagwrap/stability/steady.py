@@ -67,6 +67,9 @@ def retract(frame, z: np.ndarray, dz: np.ndarray) -> np.ndarray:
     e_new = xn[k + 1:] - xn[k:-1]
     lo = np.linalg.norm(e_old, axis=1)
     l1 = lo + np.einsum("ij,ij->i", e_old, e_new - e_old) / lo
+    # a step of a bond's size is far outside the linear regime: keep the length positive
+    # (Newton's max_step rejects such steps; a predictor may still make one)
+    l1 = np.clip(l1, 0.5 * lo, 1.5 * lo)
     e_new *= (l1 / np.linalg.norm(e_new, axis=1))[:, None]
     out = z + dz
     out[: frame.n3] = (x[k] + np.cumsum(e_new, axis=0)).ravel()
@@ -132,3 +135,31 @@ def extrapolate(frame, a: SteadyState, b: SteadyState, machin: float) -> np.ndar
     """Secant predictor in ``log M`` from two states on the branch."""
     r = math.log(machin / b.machin) / math.log(b.machin / a.machin)
     return retract(frame, b.z, r * (b.z - a.z))
+
+
+def branch(frame, machins, m_start: float = 10.0, factor: float = 1.25) -> dict:
+    """Steady states at each of ``machins``, by continuation from the rest shape at
+    ``m_start`` (secant predictor, steps of at most ``factor``, halved where Newton fails).
+    Returns ``{M: SteadyState}``; raises :class:`NewtonFailure` where the branch is lost."""
+    targets = sorted(float(m) for m in machins)
+    z, base = initial_guess(frame)
+    m = min(float(m_start), targets[0])
+    cur = newton(frame, m, z, base)
+    prev = None
+    out = {}
+    for target in targets:
+        f = factor
+        while cur.machin < target * (1 - 1e-12):
+            m_next = min(cur.machin * f, target)
+            guess = extrapolate(frame, prev, cur, m_next) if prev is not None else cur.z
+            try:
+                nxt = newton(frame, m_next, guess, cur.base)
+            except NewtonFailure:
+                f = math.sqrt(f)
+                if f < 1.001:
+                    raise
+                continue
+            prev, cur = cur, nxt
+            f = min(factor, f * f)
+        out[target] = cur
+    return out

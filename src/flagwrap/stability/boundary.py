@@ -1,0 +1,108 @@
+"""The stability boundary of a sweep's geometries: M_c (CW) of each helix by linear stability.
+
+A sweep file (grid or boundary mode, :mod:`flagwrap.sweep.spec`) names geometries; each gets
+:func:`flagwrap.stability.threshold.find_critical` on its config (the speed is irrelevant
+here). The runs are independent and take seconds, so they go to a process pool with one
+BLAS thread each (``workers``, default the cores). The result file is JSON, one row per
+geometry with the helix, ``M_c``, the crossing, and the fit of ``M_c = c (R/L)^-beta`` over
+the rows with a crossing. It is written atomically and read by ``flagwrap figure fig5``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+DEFAULT_OUT = "out/stability/fig5.json"
+
+
+def geometry_configs(spec) -> list:
+    """``(geometry dict, Config)`` per distinct geometry of a sweep spec."""
+    out = []
+    seen = set()
+    for case in spec.cases:
+        g = case.geometry()
+        key = tuple(sorted(g.items()))
+        if key in seen:
+            continue
+        seen.add(key)
+        out.append((g, case.config()))
+    return out
+
+
+def helix_threshold(item, m_factor: float = 30.0, rtol: float = 1e-3) -> dict:
+    """M_c of one ``(geometry, config)``: the continuation runs to ``m_factor`` x the paper's
+    scaling line. Returns a JSON-able row (never raises for a physics failure: the row says
+    what happened)."""
+    from threadpoolctl import threadpool_limits
+
+    from flagwrap.stability.threshold import critical_from_config
+
+    g, cfg = item
+    with threadpool_limits(1):
+        t0 = time.perf_counter()
+        r = critical_from_config(cfg, "cw", m_max=m_factor * cfg.machin_critical_scaling,
+                                 rtol=rtol)
+    row = dict(g)
+    row.update(machin_c=r.machin_c if r.converged else None,
+               bracket=[None if not math.isfinite(v) else v for v in r.bracket],
+               crossing=r.crossing or None, converged=r.converged, message=r.message,
+               mode_frequency=r.mode_frequency if r.converged else None,
+               machin_scaling=cfg.machin_critical_scaling,
+               ratio_to_scaling=(r.machin_c / cfg.machin_critical_scaling) if r.converged else None,
+               steady_states=len(r.branch), wall_time_s=time.perf_counter() - t0)
+    return row
+
+
+def fit_power_law(rows) -> dict:
+    """Least-squares ``ln M_c = ln c - beta ln (R/L)`` over the rows with a crossing:
+    ``prefactor`` c, ``exponent`` beta, their standard errors, ``n``; the paper's line is
+    c = 0.06, beta = 3."""
+    import numpy as np
+
+    pts = [(r["r_over_l"], r["machin_c"]) for r in rows if r.get("machin_c")]
+    if len(pts) < 3:
+        return {"n": len(pts)}
+    x = np.log([p[0] for p in pts])
+    y = np.log([p[1] for p in pts])
+    A = np.vstack([np.ones_like(x), -x]).T
+    coef, res, *_ = np.linalg.lstsq(A, y, rcond=None)
+    dof = max(1, len(x) - 2)
+    s2 = float(np.sum((y - A @ coef) ** 2)) / dof
+    cov = s2 * np.linalg.inv(A.T @ A)
+    return {"n": len(pts), "prefactor": float(math.exp(coef[0])), "exponent": float(coef[1]),
+            "ln_prefactor_se": float(math.sqrt(cov[0, 0])), "exponent_se": float(math.sqrt(cov[1, 1])),
+            "rms_ln": float(math.sqrt(s2))}
+
+
+def stability_boundary(spec, workers: int | None = None, on_row=None, **kw) -> dict:
+    """Every geometry's row (in the spec's order) and the power-law fit."""
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    items = geometry_configs(spec)
+    workers = workers or min(len(items), os.cpu_count() or 1)
+    t0 = time.perf_counter()
+    rows = []
+    if workers <= 1:
+        for it in items:
+            rows.append(helix_threshold(it, **kw))
+            if on_row:
+                on_row(rows[-1])
+    else:
+        import functools
+
+        with ProcessPoolExecutor(workers) as ex:
+            for row in ex.map(functools.partial(helix_threshold, **kw), items):
+                rows.append(row)
+                if on_row:
+                    on_row(row)
+    return {"sweep": spec.name, "rows": rows, "fit": fit_power_law(rows), "workers": workers,
+            "wall_time_s": time.perf_counter() - t0}
+
+
+def fig5_helices():
+    """The geometries of the built-in fig5 sweep (examples/sweeps/fig5.toml)."""
+    from flagwrap.sweep.spec import builtin_specs, load_spec
+
+    return geometry_configs(load_spec(builtin_specs()["fig5"]))
