@@ -123,6 +123,17 @@ HOSTILE = [
     (["export-vtk", "{d}/good.nc", "{d}/vtk", "--stride", "0"], "--stride"),
     (["snapshots", "{d}/good.nc", "-n", "0", "-o", "{d}/s.png"], "-n must be"),
     (["bacteria", "--model-boundary", "{d}/afile"], "--model-boundary"),
+    # issue 16: the stability tool
+    (["stability", "{d}/tiny.toml", "--m-start", "0"], "--m-start"),
+    (["stability", "{d}/tiny.toml", "--m-max", "5"], "--m-max"),
+    (["stability", "{d}/tiny.toml", "--rtol", "nan"], "--rtol"),
+    (["stability", "{d}/tiny.toml", "--factor", "1"], "--factor"),
+    (["stability", "{d}/tiny.toml", "--mode", "{d}/afile/m.png"], "is a file, not a folder"),
+    (["stability", "{d}/tiny.toml", "--vtk", "{d}/m.xyz"], "unknown suffix '.xyz'"),
+    (["stability", "{d}/tiny.toml", "--out", "{d}/s.json"], "--out"),
+    (["stability", "{d}/big.toml", "--sweep", "--direction", "ccw"], "--sweep"),
+    (["stability", "{d}/big.toml", "--sweep", "--workers", "0"], "--workers"),
+    (["stability", "{d}/hookneg.toml"], "joint.hook_length"),
 ]
 
 

@@ -153,9 +153,12 @@ def run(args) -> int:
         print(f"crossing: Hopf; critical pair {lam.real:+.2e} +- {abs(lam.imag):.4f}i omega at "
               f"M = {hi:.2f}: in the turning frame the mode oscillates at {res.mode_frequency:.4f} "
               f"omega_c = {res.mode_frequency * res.omega_c:.4g} rad/s")
+    elif res.crossing == "fold":
+        print(f"crossing: fold of the steady branch (real eigenvalue {lam.real:+.2e} omega at "
+              f"M = {lo:.2f}, going to zero): beyond M_c this steady whirl does not exist")
     else:
         print(f"crossing: steady (real eigenvalue {lam.real:+.2e} omega at M = {hi:.2f}): a new "
-              f"steadily turning shape branches off, or the branch folds")
+              f"steadily turning shape branches off")
     tip = res.state.info.x[-1, 2] if res.state is not None else math.nan
     print(f"steady shape at M_c: free end {(tip - res.tip_z0):+.4f} L above its rest height "
           f"({(tip - res.tip_z0) * L * 1e3:+.3g} mm)")
@@ -174,7 +177,8 @@ def _write_mode(frame, res, cfg, args) -> list:
     from flagwrap.stability.spectrum import mode_positions, spectrum
 
     sp = spectrum(frame, res.state, vectors=True)
-    mode = mode_positions(frame, sp.vectors[:, 0])
+    k = int(np.argmin(np.abs(sp.values - res.eigenvalue)))  # the critical one (a fold's is real)
+    mode = mode_positions(frame, sp.vectors[:, k])
     x = res.state.info.x
     L = cfg.filament.length
     files = []

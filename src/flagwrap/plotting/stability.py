@@ -35,7 +35,7 @@ def plot_mode(x, mode, result, config, path, amplitude: float = 0.05):
     ax[1].plot(s, np.linalg.norm(mode, axis=1), "C3")
     ax[1].set_xlabel("s / L (clamp at 0)")
     ax[1].set_ylabel("|mode| (largest = 1)")
-    kind = "Hopf" if result.crossing == "hopf" else "steady"
+    kind = {"hopf": "Hopf", "fold": "fold"}.get(result.crossing, "steady")
     ax[1].set_title(f"(b) mode amplitude ({kind}, Omega = {result.mode_frequency:.3f} omega)",
                     fontsize=9)
     pts = sorted(result.branch, key=lambda p: p.machin)

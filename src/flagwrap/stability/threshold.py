@@ -46,12 +46,14 @@ class BranchPoint:
     tip_z: float
     residual: float
     iterations: int
+    real_leading: float = math.nan  # the largest real eigenvalue (a fold's signature)
 
     def as_dict(self) -> dict:
         return {"machin": self.machin, "leading_re": self.leading.real,
                 "leading_im": abs(self.leading.imag), "second_re": self.second.real,
                 "second_im": abs(self.second.imag), "tip_z": self.tip_z,
-                "residual": self.residual, "iterations": self.iterations}
+                "residual": self.residual, "iterations": self.iterations,
+                "real_leading": self.real_leading}
 
 
 @dataclass
@@ -63,7 +65,7 @@ class StabilityResult:
     message: str
     machin_c: float = math.nan
     bracket: tuple = (math.nan, math.nan)
-    crossing: str = ""  # "hopf" or "steady"
+    crossing: str = ""  # "hopf", "steady" (a real eigenvalue crosses) or "fold"
     eigenvalue: complex = complex(math.nan, math.nan)  # at the upper end of the bracket
     mode_frequency: float = math.nan  # |Im| of the critical pair / omega (turning frame)
     omega_c: float = math.nan  # SI [rad/s]
@@ -91,8 +93,10 @@ def _point(frame, state):
     second = sp.values[1]
     if sp.values[0].imag != 0.0 and len(sp.values) > 2:  # skip the conjugate partner
         second = sp.values[2]
+    real = sp.values[sp.values.imag == 0.0]
     return BranchPoint(state.machin, sp.leading, complex(second), float(state.info.x[-1, 2]),
-                       state.residual, state.iterations)
+                       state.residual, state.iterations,
+                       float(real[0].real) if real.size else math.nan)
 
 
 def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: float = 1.25,
@@ -139,7 +143,7 @@ def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: floa
                        f"eigenvalue {p.leading.real:+.3g} {abs(p.leading.imag):+.3g}i): "
                        f"lower --m-start")
         return _done(res, t0)
-    prev = None
+    prev = prev_p = None
     f = factor
     while cur.machin < m_max * (1 - 1e-12):
         m_next = min(cur.machin * f, m_max)
@@ -149,16 +153,18 @@ def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: floa
         except NewtonFailure:
             f = math.sqrt(f)
             if f < 1.001:
+                if _fold(res, prev_p, p, cur, m_next, omega_si, machin_si):
+                    return _done(res, t0)
                 res.message = (f"the steady branch could not be continued beyond M = "
-                               f"{cur.machin:.6g} (a fold of the branch or a sharp turn), stable "
-                               f"up to there")
+                               f"{cur.machin:.6g} (a sharp turn, or a fold without a real "
+                               f"eigenvalue going to zero), stable up to there")
                 res.bracket = (cur.machin, math.nan)
                 return _done(res, t0)
             continue
         pn = record(nxt)
         if pn.leading.real >= 0.0:
             return _refine(frame, res, cur, p, nxt, pn, rtol, record, t0, omega_si, machin_si)
-        prev, cur, p = cur, nxt, pn
+        prev, cur, prev_p, p = cur, nxt, p, pn
         f = min(factor, f * f) if nxt.iterations <= 5 else f
     res.message = f"stable up to M = {m_max:g} (no crossing in the range scanned: raise --m-max)"
     res.bracket = (cur.machin, math.nan)
@@ -195,6 +201,37 @@ def _refine(frame, res, lo, plo, hi, phi, rtol, record, t0, omega_si, machin_si)
         res.omega_c = abs(omega_si) * res.machin_c / machin_si
         res.frequency_c = res.omega_c / (2 * math.pi)
     return _done(res, t0)
+
+
+def _fold(res, pa, pb, state, m_failed, omega_si, machin_si) -> bool:
+    """A fold (saddle-node) of the branch: Newton fails just beyond ``pb`` while the leading
+    eigenvalue is real, negative and shrinking towards zero. Near a fold it goes as
+    ``sqrt(M_f - M)``, so ``lambda^2`` is linear in ``M``. Its zero from the last two points
+    is ``M_f``, the threshold: beyond it this steady state does not exist. Fills ``res``;
+    False when the last points do not look like a fold."""
+    if pa is None:
+        return False
+    la, lb = pa.real_leading, pb.real_leading
+    if not (la < lb < 0.0):
+        return False
+    slope = (lb**2 - la**2) / (pb.machin - pa.machin)  # < 0
+    m_f = pb.machin - lb**2 / slope
+    if not pb.machin <= m_f <= 1.1 * m_failed:
+        return False
+    res.machin_c = m_f
+    res.bracket = (pb.machin, max(m_f, m_failed))
+    res.crossing = "fold"
+    res.eigenvalue = complex(lb, 0.0)
+    res.mode_frequency = 0.0
+    res.state = state
+    res.converged = True
+    res.message = (f"the steady branch folds: a real eigenvalue goes to zero "
+                   f"({la:+.3g} at M = {pa.machin:.5g}, {lb:+.3g} at {pb.machin:.5g}) and Newton "
+                   f"finds no steady state beyond; M_c = M_fold extrapolated by the square-root law")
+    if omega_si is not None and machin_si:
+        res.omega_c = abs(omega_si) * res.machin_c / machin_si
+        res.frequency_c = res.omega_c / (2 * math.pi)
+    return True
 
 
 def _done(res, t0):

@@ -1,0 +1,66 @@
+"""``flagwrap stability``: output, exit codes, the sweep mode (a 21-bead helix: seconds)."""
+
+import json
+
+import pytest
+
+from conftest import tiny_toml
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    d = tmp_path_factory.mktemp("stab")
+    (d / "tiny.toml").write_text(tiny_toml())
+    return d
+
+
+def test_json_result_names_the_threshold_and_the_crossing(tiny, capsys):
+    from flagwrap.cli.main import main
+
+    code = main(["stability", str(tiny / "tiny.toml"), "--json", "--vtk", str(tiny / "m.vtp"),
+                 "--mode", str(tiny / "m.png")])
+    s = json.loads(capsys.readouterr().out)
+    assert code == 0 and s["converged"]
+    lo, hi = s["bracket"]
+    assert lo < s["machin_c"] < hi and hi / lo - 1 <= 1e-3
+    assert s["crossing"] in ("hopf", "fold", "steady")
+    # omega_c is M_c in SI units: omega_c / M_c = A / (eta L^4) of the config
+    from flagwrap.io.config import load_config
+
+    cfg = load_config(tiny / "tiny.toml")
+    assert s["omega_c"] == pytest.approx(cfg.omega * s["machin_c"] / cfg.machin, rel=1e-12)
+    assert (tiny / "m.vtp").stat().st_size > 0 and (tiny / "m.png").stat().st_size > 0
+    assert "mode_real" in (tiny / "m.vtp").read_text()
+
+
+def test_no_crossing_in_the_range_is_exit_1_with_what_was_found(tiny, capsys):
+    from flagwrap.cli.main import main
+
+    code = main(["stability", str(tiny / "tiny.toml"), "--m-max", "40"])
+    out = capsys.readouterr().out
+    assert code == 1 and "NOT FOUND: stable up to M = 40" in out and "raise --m-max" in out
+
+
+def test_unreachable_start_is_exit_1(tiny, capsys):
+    from flagwrap.cli.main import main
+
+    # so far from the rest shape that Newton cannot start (halved 8 times: still 2e4)
+    code = main(["stability", str(tiny / "tiny.toml"), "--m-start", "5e6", "--m-max", "1e7"])
+    out = capsys.readouterr().out
+    assert code == 1 and "NOT FOUND" in out
+
+
+def test_sweep_mode_writes_one_row_per_geometry_and_a_fit(tiny, capsys):
+    from flagwrap.cli.main import main
+
+    spec = tiny / "sw.toml"
+    spec.write_text('name = "sw"\nmode = "grid"\n[grid]\npsi_deg = [70.0]\nturns = [2.0, 3.0, 3.5]\n'
+                    'machin = 100.0\n[base.filament]\nn_beads = 21\n')
+    out = tiny / "sw.json"
+    code = main(["stability", str(spec), "--sweep", "--workers", "1", "--out", str(out)])
+    text = capsys.readouterr().out
+    res = json.loads(out.read_text())
+    assert code == 0, text
+    assert len(res["rows"]) == 3 and all(r["converged"] for r in res["rows"])
+    assert res["fit"]["n"] == 3 and res["fit"]["exponent"] > 0
+    assert "fit over 3 helices" in text
