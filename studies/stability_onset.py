@@ -5,9 +5,10 @@ supercritical, and why does the time-domain M_c (576) lie below the linear one (
     python studies/stability_onset.py hysteresis   # (b) M stepped up through M_c and back
     python studies/stability_onset.py protocol     # (c) the paper protocol's CW phase seen
                                                    #     against the steady CW state
-    python studies/stability_onset.py amplitude    # (e) saturated amplitude just above M_c
     python studies/stability_onset.py verdict      # (d) the rise criterion's verdict on long
                                                    #     CW phases between the two thresholds
+    python studies/stability_onset.py amplitude    # (e) saturated amplitude just above M_c
+    python studies/stability_onset.py cycle        # (f) that oscillation taken below M_c
 
 All runs: the Fig. 4(a) helix (examples/fig4a.toml), HI on, tol 1e-5, stepped in the turning
 frame (numerics.frame = "rotating"; tests/unit/test_rotating.py checks it against the lab
@@ -207,7 +208,41 @@ def amplitude(turns=100.0):
               + " | ".join(f"{c:.3g}" for c in cols) + " |", flush=True)
 
 
+def cycle():
+    """Sub- or supercritical: saturate the oscillation at M = 635 (eps = 0.03, 100 turns from a
+    1e-3 L kick), then lower M below M_c (610, then 590) for 50 turns each. A supercritical
+    Hopf has no cycle below M_c: the oscillation decays back to the whirl. A subcritical one
+    keeps a finite-amplitude cycle there, beside the stable whirl."""
+    M0 = 635.0
+    plan = [(1.0, 100.0), (610.0 / M0, 50.0), (590.0 / M0, 50.0)]
+    cfg = config(M0, tuple(Phase("cw", n, s) for s, n in plan))
+    base_sys = RodSystem(cfg)
+    frame = RotatingFrame(base_sys, -1.0)
+    machins = [round(M0 * s, 6) for s, _ in plan]
+    r, states = steady(frame, machins)
+    st = states[machins[0]]
+    sp = spectrum(frame, st, vectors=True)
+    mode = mode_vector(frame, sp.vectors[:, 0]).real
+    y0 = frame.full(retract(frame, st.z, 1e-3 * mode))
+    system = make_system(cfg)
+    tr = Simulation(cfg, system=system).run(y0=y0, base=st.base)
+    sched = system.schedule
+    shapes = {m: base_sys.unpack(frame.full(s.z))[0] for m, s in states.items()}
+    t, dev, _ = deviation(frame, tr, lambda tt: shapes[machins[sched.segment_index(tt)]])
+    print(f"linear M_c = {r.machin_c:.1f}; {tr.status} {tr.message} {tr.n_steps} steps")
+    print("| phase | M | linear | mean distance from the whirl per 10 turns [L] |")
+    print("|---:|---:|---|---|")
+    for k, seg in enumerate(sched.segments):
+        m = machins[k]
+        n = int(round(plan[k][1] / 10))
+        T = TWO_PI / abs(seg.omega)
+        cols = [dev[(t > seg.t0 + 10 * j * T) & (t <= seg.t0 + 10 * (j + 1) * T)].mean()
+                for j in range(n)]
+        print(f"| {k + 1} | {m:g} | {'stable' if m < r.machin_c else 'unstable'} | "
+              + ", ".join(f"{c:.3g}" for c in cols) + " |", flush=True)
+
+
 if __name__ == "__main__":
     what = sys.argv[1] if len(sys.argv) > 1 else "basin"
     {"basin": basin, "hysteresis": hysteresis, "protocol": protocol, "verdict": verdict,
-     "amplitude": amplitude}[what]()
+     "amplitude": amplitude, "cycle": cycle}[what]()

@@ -107,7 +107,8 @@ def classify(row: dict) -> str:
     return "wrapping" if row.get("state") == "wrapping" else "folding"
 
 
-def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.0, 72.0)):
+def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.0, 72.0),
+            stability=None):
     """Draw the diagram of ``rows`` on ``ax`` (new figure if None); returns the axes.
 
     Parameters
@@ -120,6 +121,8 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
         :func:`fit_boundary` result: its line is drawn if finite.
     brackets : list of dict, optional
         per-geometry brackets; two-sided ones are drawn as black bars (M_lo..M_hi).
+    stability : dict, optional
+        ``flagwrap stability --sweep`` result: its linear thresholds (:func:`draw_stability`).
     """
     import matplotlib.pyplot as plt
     from matplotlib.colors import Normalize
@@ -168,6 +171,8 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
             c3 = fit["prefactor_beta3"]
             ax.plot(xline, c3 / xline, ":", color="tab:red", lw=1.5,
                     label=rf"fit, exponent $-3$: $M_c = {c3:.3g}\,(R/L)^{{-3}}$")
+    if stability is not None:
+        draw_stability(ax, stability)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(r"$(R/L)^3$")
@@ -186,12 +191,52 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
     return ax
 
 
-def fig5(outdir="out/figures", sweep_dirs=None) -> list:
+DEFAULT_STABILITY = "out/stability/fig5.json"
+
+
+def load_stability(path):
+    """The rows of ``flagwrap stability --sweep`` (None if the file is absent)."""
+    import json
+
+    p = Path(path) if path else None
+    if p is None or not p.is_file():
+        return None
+    try:
+        return json.loads(p.read_text())
+    except (OSError, ValueError) as exc:
+        raise UserInputError(f"{p} is not a readable stability result ({exc}); re-create it with "
+                             f"`flagwrap stability examples/sweeps/fig5.toml --sweep`") from None
+
+
+def draw_stability(ax, stab):
+    """The linear thresholds (diamonds, red edge; colour = psi) and their power-law fit."""
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import Normalize
+
+    cmap, norm = plt.get_cmap("viridis"), Normalize(30.0, 72.0)
+    pts = [r for r in stab.get("rows", []) if r.get("machin_c")]
+    for i, r in enumerate(pts):
+        ax.scatter([r["r_over_l"] ** 3], [r["machin_c"]], marker="D", s=34, zorder=5,
+                   facecolors=cmap(norm(r["psi_deg"])), edgecolors="tab:red", linewidths=1.2,
+                   label="linear M_c (flagwrap stability)" if i == 0 else None)
+    fit = stab.get("fit") or {}
+    if pts and math.isfinite(fit.get("exponent", math.nan)):
+        xs = np.array([r["r_over_l"] ** 3 for r in pts])
+        xline = np.logspace(np.log10(xs.min()) - 0.1, np.log10(xs.max()) + 0.1, 30)
+        c, be = fit["prefactor"], fit["exponent"]
+        ax.plot(xline, c * xline ** (-be / 3), "-.", color="tab:red", lw=1.2,
+                label=rf"linear: $M_c = {c:.3g}\,(R/L)^{{-{be:.2f}}}$")
+
+
+def fig5(outdir="out/figures", sweep_dirs=None, stability=DEFAULT_STABILITY) -> list:
     """``flagwrap figure fig5``: the diagram from the sweep table (PNG + PDF) and the fit (JSON).
 
     Reads the rows of out/sweeps/fig5 (or, if it has none, out/sweeps/fig5-quick and
     out/sweeps/fig5-boundary; :func:`load_rows`); writes
     ``fig5.png``, ``fig5.pdf`` and ``fig5.json`` (fit, per-geometry brackets, sources).
+    If ``stability`` (out/stability/fig5.json, from ``flagwrap stability
+    examples/sweeps/fig5.toml --sweep``) exists, its linear thresholds and their fit are drawn
+    beside the time-domain classes and stored in fig5.json under ``stability``.
     """
     import matplotlib
 
@@ -207,7 +252,8 @@ def fig5(outdir="out/figures", sweep_dirs=None) -> list:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(6.8, 6.4))
-    diagram(rows, ax=ax, fit=fit, brackets=brackets)
+    stab = load_stability(stability)
+    diagram(rows, ax=ax, fit=fit, brackets=brackets, stability=stab)
     n_beads = sorted({r.get("n_beads") for r in rows})
     ax.set_title(f"stability diagram, this model ({len(rows)} runs, N = "
                  f"{', '.join(map(str, n_beads))}; {' + '.join(Path(u).name for u in used)})",
@@ -222,6 +268,9 @@ def fig5(outdir="out/figures", sweep_dirs=None) -> list:
         counts[classify(r)] = counts.get(classify(r), 0) + 1
     info = {"sources": used, "n_rows": len(rows), "classes": counts, "fit": fit,
             "paper": {"prefactor": PAPER_PREFACTOR, "exponent": 3.0}, "brackets": brackets}
+    if stab is not None:
+        info["stability"] = {"source": str(stability), "fit": stab.get("fit"),
+                             "rows": stab.get("rows")}
     paths.append(write_json_atomic(jsonable(info), outdir / "fig5.json"))
     return [str(p) for p in paths]
 
