@@ -89,3 +89,28 @@ def test_user_file_errors(tmp_path, body, match):
     p.write_text(body)
     with pytest.raises(UserInputError, match=match):
         load_species_file(p)
+
+
+def test_species_filament_config_has_the_species_machin_number_and_geometry():
+    from flagwrap.bacteria.species import default_species
+    from flagwrap.bacteria.stability import species_config
+
+    sp = next(s for s in default_species() if s.key == "s_putrefaciens")
+    cfg = species_config(sp)
+    # A = n pi E a^4 / 4 either way: the bundle as one filament of Young's modulus n E
+    assert cfg.machin == pytest.approx(sp.machin, rel=1e-12)
+    assert cfg.filament.helix_radius / cfg.filament.length == pytest.approx(sp.radius_um / sp.length_um)
+    assert cfg.filament.pitch == pytest.approx(sp.pitch_um * 1e-6)
+    # beads at the rig's spacing: a / b = 1.5 / (400 / 60)
+    b = cfg.filament.length / (cfg.filament.n_beads - 1)
+    assert cfg.filament.cross_section_radius / b == pytest.approx(0.225, rel=0.01)
+
+
+def test_species_without_a_pitch_is_refused_by_name():
+    from flagwrap.bacteria.species import default_species
+    from flagwrap.bacteria.stability import species_config
+    from flagwrap.errors import UserInputError
+
+    sp = next(s for s in default_species() if s.key == "c_insecticola_coil")
+    with pytest.raises(UserInputError, match="c_insecticola_coil.*pitch_um"):
+        species_config(sp)

@@ -16,6 +16,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--prefactor", type=float, default=0.06, help="c in M_c = c (R/L)^-3 (default 0.06)")
     parser.add_argument("--sources", action="store_true", help="also list every parameter's source and status")
     parser.add_argument("--csv", action="store_true", help="machine-readable CSV instead of the table")
+    parser.add_argument("--stability", action="store_true",
+                        help="also compute THIS model's linear threshold for each species' own "
+                             "geometry (flagwrap stability on its filament: ~20-30 s per species; "
+                             "docs/stability.md)")
     parser.add_argument("--model-boundary", metavar="JSON", default=None,
                         help="also place each species against THIS model's density-matched (G = 0) "
                              "boundary, read from `flagwrap figure gravity`'s gravity.json (its 0 %% "
@@ -54,6 +58,9 @@ def run(args: argparse.Namespace) -> int:
     if args.model_boundary is not None:
         print()
         print(format_model_boundary(species, load_model_boundary(args.model_boundary), args.model_boundary))
+    if args.stability:
+        print()
+        print(format_stability(species))
     if args.sources:
         for s in species:
             print(f"\n[{s.key}] {s.name} ({s.form})")
@@ -112,4 +119,30 @@ def format_model_boundary(species, fit: dict, source) -> str:
         if free:
             row += f" {s.machin / (c * rl ** -beta):>11.3g}"
         lines.append(row + f"  {'unstable' if r3 > 1 else 'stable'}")
+    return "\n".join(lines)
+
+
+def format_stability(species) -> str:
+    """Each species' M against this model's linear M_c for its own filament."""
+    from flagwrap.bacteria.stability import species_threshold
+    from flagwrap.errors import UserInputError
+
+    head = (f"{'species':<39} {'N':>4} {'M':>8} {'M_c model':>10} {'crossing':>8} "
+            f"{'M/M_c model':>11} {'M/M_c paper':>11}  side (model)")
+    lines = ["This model's linear threshold (flagwrap stability, CW, HI on, clamp) for each "
+             "species' own R, P, L, a and bundle stiffness, beads at the rig's spacing "
+             "(docs/stability.md, docs/bacteria.md):", head, "-" * len(head)]
+    for s in species:
+        label = f"{s.name[:30]} ({s.form})"
+        try:
+            r = species_threshold(s)
+        except UserInputError as exc:
+            lines.append(f"{label:<39} not computed: {exc}")
+            continue
+        if not r["converged"]:
+            lines.append(f"{label:<39} {r['n_beads']:>4} {r['machin']:>8.4g} not found: {r['message']}")
+            continue
+        side = "unstable" if r["ratio_model"] > 1 else "stable"
+        lines.append(f"{label:<39} {r['n_beads']:>4} {r['machin']:>8.4g} {r['machin_c_model']:>10.4g} "
+                     f"{r['crossing']:>8} {r['ratio_model']:>11.3g} {r['ratio_paper_line']:>11.3g}  {side}")
     return "\n".join(lines)
