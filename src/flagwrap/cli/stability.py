@@ -25,7 +25,8 @@ import math
 
 
 def add_arguments(p):
-    p.add_argument("config", metavar="CONFIG.toml", help="geometry/fluid/numerics (its M and protocol are not used)")
+    p.add_argument("config", metavar="CONFIG.toml",
+                   help="geometry/fluid/numerics (its M and protocol are not used)")
     p.add_argument("--direction", choices=["cw", "ccw"], default="cw",
                    help="motor direction of the steady state (cw: the buckling one; default)")
     p.add_argument("--m-start", type=float, default=10.0, help="first M of the continuation (10)")
@@ -34,7 +35,8 @@ def add_arguments(p):
     p.add_argument("--rtol", type=float, default=1e-3, help="relative width of the final M bracket (1e-3)")
     p.add_argument("--factor", type=float, default=1.25, help="largest continuation step in M (x1.25)")
     p.add_argument("--no-hi", action="store_true", help="switch hydrodynamic interactions off")
-    p.add_argument("--mode", default=None, metavar="FILE.png", help="plot the steady shape and the critical mode")
+    p.add_argument("--mode", default=None, metavar="FILE.png",
+                   help="plot the steady shape and the critical mode")
     p.add_argument("--vtk", default=None, metavar="FILE.vtp",
                    help="write the steady shape at M_c with the critical mode as point data (ParaView)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")

@@ -27,8 +27,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from flagwrap.stability.spectrum import spectrum
 from flagwrap.stability.steady import NewtonFailure, extrapolate, initial_guess, newton
 
