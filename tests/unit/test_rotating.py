@@ -139,4 +139,3 @@ def test_buckling_run_in_the_turning_frame_has_the_lab_runs_onset_and_torque(tmp
     assert a["buckled"] and b["buckled"]
     assert abs(a["waiting_time_turns"] - b["waiting_time_turns"]) <= 0.05 + 1e-9
     assert b["torque_peak_reduced"] == pytest.approx(a["torque_peak_reduced"], rel=5e-2)
-
