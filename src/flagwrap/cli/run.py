@@ -32,6 +32,9 @@ def add_arguments(p):
     p.add_argument("--figure", help="also write a summary figure (PNG/PDF) of tip height and torque")
     p.add_argument("--no-hi", action="store_true", help="switch long-range hydrodynamics off")
     p.add_argument("--integrator", choices=["ros34pw2", "ros2", "euler"], help="override numerics.integrator")
+    p.add_argument("--frame", choices=["lab", "rotating"], default=None,
+                   help="step in the lab frame or the frame turning with the motor (numerics.frame; "
+                        "docs/stability.md); the run file is in the lab frame either way")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--perturb", type=float, default=None, metavar="METRES",
                    help="start from the rest shape displaced by at most this much (overrides "
@@ -68,6 +71,8 @@ def load(args):
         num = dataclasses.replace(num, hydrodynamics=False)
     if args.integrator:
         num = dataclasses.replace(num, integrator=args.integrator)
+    if getattr(args, "frame", None):
+        num = dataclasses.replace(num, frame=args.frame)
     ini = cfg.initial
     changes = {k: v for k, v in (("perturbation", getattr(args, "perturb", None)),
                                  ("seed", getattr(args, "seed", None)),
