@@ -42,6 +42,18 @@ def cross_matrix(a) -> np.ndarray:
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
+def subtract_rotation(f, system, info, omega: float, axis, A) -> None:
+    """The turning frame's terms, in place on a lab-layout velocity ``f``:
+    ``- omega a x x_i`` for the free beads and ``- omega (a . t_j)`` for the free bonds
+    (module docstring); ``A = [a]_x``. ``a x x_i`` for every bead is one product with
+    ``[a]_x`` (np.cross cost more than the forces here)."""
+    if omega == 0.0:
+        return
+    s = system
+    f[s.sl_x] -= omega * (info.x[s.nc:] @ A.T).ravel()
+    f[s.sl_th] -= omega * (info.frames.t[s.ec:] @ axis)
+
+
 def check_rotating_frame(system) -> None:
     """Refuse a system whose equations are not autonomous in the turning frame (one line,
     naming the part that breaks the symmetry about the motor axis)."""
@@ -94,20 +106,6 @@ class RotatingFrame:
         y[-1] = 0.0
         return y
 
-    def lab_to_rotating(self, y, base):
-        """``(z, base')`` of a lab state at motor angle ``y[-1]``: positions and reference
-        directors turned back by ``phi``; the twist angles are unchanged (they are measured
-        from the turned directors)."""
-        s = self.system
-        phi = float(y[s.i_phi])
-        R = rotation(self.axis, -phi)
-        z = np.array(y[:-1], float)
-        xs = z[s.sl_x].reshape(-1, 3) @ R.T
-        z[s.sl_x] = xs.ravel()
-        from flagwrap.elasticity.rod import Frames
-
-        return z, Frames(base.t @ R.T, base.d1 @ R.T, base.rt.copy())
-
     def scale(self, machin: float | None) -> float:
         return 1.0 if machin is None else self.system.machin / float(machin)
 
@@ -117,12 +115,10 @@ class RotatingFrame:
         s = self.system
         y = self.full(z)
         info = s.forces(y, base)
-        f = s.apply_mobility(y, info.G)[:-1]
+        f = s.apply_mobility(y, info.G)
         f *= self.scale(machin)
-        x = info.x[s.nc:]
-        f[: self.n3] -= self.omega * np.cross(self.axis, x).ravel()
-        f[self.n3:] -= self.omega * (info.frames.t[s.ec:] @ self.axis)
-        return f, info
+        subtract_rotation(f, s, info, self.omega, self.axis, self._A)
+        return f[:-1], info
 
     def jacobian(self, z, base, machin: float | None = None, info=None) -> np.ndarray:
         """``d(dz/dt)/dz`` (n, n), dense, at ``z`` in the chart of ``base``.
@@ -227,10 +223,7 @@ class RotatingSystem:
     def velocity(self, y, info, omega: float) -> np.ndarray:
         s = self.inner
         f = s.apply_mobility(y, info.G)
-        if omega != 0.0:
-            # a x x_i for every bead as one product with [a]_x (np.cross costs more here)
-            f[s.sl_x] -= omega * (info.x[s.nc:] @ self._A.T).ravel()
-            f[s.sl_th] -= omega * (info.frames.t[s.ec:] @ self.axis)
+        subtract_rotation(f, s, info, omega, self.axis, self._A)
         f[s.i_phi] = omega
         return f
 
