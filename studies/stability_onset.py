@@ -50,7 +50,21 @@ def steady(frame, machins):
     return r, branch(frame, machins)
 
 
-def deviation(frame, tr, x_star, speed_of=None):
+def on_whirl(M, protocol):
+    """The config at ``M`` with ``protocol``, its turning frame (CW), the linear threshold, the
+    steady CW whirl at ``M``, its spectrum, its critical mode (a real vector over the unknowns,
+    largest bead displacement 1) and its bead positions."""
+    cfg = config(M, protocol)
+    base_sys = RodSystem(cfg)
+    frame = RotatingFrame(base_sys, -1.0)
+    r, st = steady(frame, [M])
+    st = st[M]
+    sp = spectrum(frame, st, vectors=True)
+    mode = mode_vector(frame, sp.vectors[:, 0]).real
+    return cfg, frame, r, st, sp, mode, base_sys.unpack(frame.full(st.z))[0]
+
+
+def deviation(frame, tr, x_star):
     """Largest bead distance from ``x_star`` (turning frame) at each recorded frame, and the
     free end's height minus the steady one's."""
     A = tr.arrays()
@@ -66,14 +80,7 @@ def deviation(frame, tr, x_star, speed_of=None):
 
 def basin():
     M = 600.0
-    cfg = config(M, (Phase("cw", 10.0, 1.0),))
-    base_sys = RodSystem(cfg)
-    frame = RotatingFrame(base_sys, -1.0)
-    r, st = steady(frame, [M])
-    st = st[M]
-    sp = spectrum(frame, st, vectors=True)
-    mode = mode_vector(frame, sp.vectors[:, 0]).real
-    x = base_sys.unpack(frame.full(st.z))[0]
+    cfg, frame, r, st, sp, mode, x = on_whirl(M, (Phase("cw", 10.0, 1.0),))
     print(f"M = {M:g}: linear M_c = {r.machin_c:.1f}; leading eigenvalue "
           f"{sp.leading.real:+.4f} +- {abs(sp.leading.imag):.4f}i")
     print("| perturbation along the critical mode [L] | largest deviation in 10 CW turns [L] | "
@@ -191,14 +198,7 @@ def amplitude(turns=100.0):
         f"turns {a:g}-{b:g}" for a, b in zip(windows[:-1], windows[1:])) + " |")
     print("|---:|---:|---:|" + "---:|" * (len(windows) - 1))
     for M in (625.0, 635.0, 650.0):
-        cfg = config(M, (Phase("cw", turns, 1.0),))
-        base_sys = RodSystem(cfg)
-        frame = RotatingFrame(base_sys, -1.0)
-        r, st = steady(frame, [M])
-        st = st[M]
-        sp = spectrum(frame, st, vectors=True)
-        mode = mode_vector(frame, sp.vectors[:, 0]).real
-        x = base_sys.unpack(frame.full(st.z))[0]
+        cfg, frame, r, st, sp, mode, x = on_whirl(M, (Phase("cw", turns, 1.0),))
         y0 = frame.full(retract(frame, st.z, 1e-3 * mode))
         tr = Simulation(cfg, system=make_system(cfg)).run(y0=y0, base=st.base)
         t, dev, _ = deviation(frame, tr, x)

@@ -137,29 +137,48 @@ def extrapolate(frame, a: SteadyState, b: SteadyState, machin: float) -> np.ndar
     return retract(frame, b.z, r * (b.z - a.z))
 
 
+class BranchLost(NewtonFailure):
+    """The continuation could not step beyond ``state``; ``m_failed``: the last M tried."""
+
+    def __init__(self, message, state, m_failed):
+        super().__init__(message, state)
+        self.m_failed = m_failed
+
+
+def march(frame, cur: SteadyState, m_stop: float, factor: float = 1.25, prev=None):
+    """Continue the branch from ``cur`` (``prev``: the state before it, for the secant
+    predictor) up to ``m_stop``, yielding each new steady state. Steps are at most ``factor``
+    in M. A step where Newton fails is retried with its factor square-rooted, and the factor
+    grows back (squared, up to ``factor``) after a step of at most 5 iterations. Raises
+    :class:`BranchLost` once the factor would fall below 1.001."""
+    f = factor
+    while cur.machin < m_stop * (1 - 1e-12):
+        m_next = min(cur.machin * f, m_stop)
+        guess = extrapolate(frame, prev, cur, m_next) if prev is not None else cur.z
+        try:
+            nxt = newton(frame, m_next, guess, cur.base)
+        except NewtonFailure:
+            f = math.sqrt(f)
+            if f < 1.001:
+                raise BranchLost(f"the steady branch could not be continued beyond M = "
+                                 f"{cur.machin:.6g}", cur, m_next) from None
+            continue
+        prev, cur = cur, nxt
+        yield nxt
+        f = min(factor, f * f) if nxt.iterations <= 5 else f
+
+
 def branch(frame, machins, m_start: float = 10.0, factor: float = 1.25) -> dict:
-    """Steady states at each of ``machins``, by continuation from the rest shape at
-    ``m_start`` (secant predictor, steps of at most ``factor``, halved where Newton fails).
-    Returns ``{M: SteadyState}``; raises :class:`NewtonFailure` where the branch is lost."""
+    """Steady states at each of ``machins``, by continuation (:func:`march`) from the rest
+    shape at ``m_start``. Returns ``{M: SteadyState}``; raises :class:`BranchLost` where the
+    branch is lost."""
     targets = sorted(float(m) for m in machins)
     z, base = initial_guess(frame)
-    m = min(float(m_start), targets[0])
-    cur = newton(frame, m, z, base)
+    cur = newton(frame, min(float(m_start), targets[0]), z, base)
     prev = None
     out = {}
     for target in targets:
-        f = factor
-        while cur.machin < target * (1 - 1e-12):
-            m_next = min(cur.machin * f, target)
-            guess = extrapolate(frame, prev, cur, m_next) if prev is not None else cur.z
-            try:
-                nxt = newton(frame, m_next, guess, cur.base)
-            except NewtonFailure:
-                f = math.sqrt(f)
-                if f < 1.001:
-                    raise
-                continue
+        for nxt in march(frame, cur, target, factor, prev):
             prev, cur = cur, nxt
-            f = min(factor, f * f)
         out[target] = cur
     return out

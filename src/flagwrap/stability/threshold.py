@@ -28,7 +28,8 @@ import math
 from dataclasses import dataclass, field
 
 from flagwrap.stability.spectrum import spectrum
-from flagwrap.stability.steady import NewtonFailure, extrapolate, initial_guess, newton
+from flagwrap.stability.steady import (BranchLost, NewtonFailure, extrapolate, initial_guess,
+                                       march, newton)
 
 DIRECTIONS = {"ccw": 1.0, "cw": -1.0}
 
@@ -141,29 +142,21 @@ def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: floa
                        f"eigenvalue {p.leading.real:+.3g} {abs(p.leading.imag):+.3g}i): "
                        f"lower --m-start")
         return _done(res, t0)
-    prev = prev_p = None
-    f = factor
-    while cur.machin < m_max * (1 - 1e-12):
-        m_next = min(cur.machin * f, m_max)
-        guess = extrapolate(frame, prev, cur, m_next) if prev is not None else cur.z
-        try:
-            nxt = newton(frame, m_next, guess, cur.base)
-        except NewtonFailure:
-            f = math.sqrt(f)
-            if f < 1.001:
-                if _fold(res, prev_p, p, cur, m_next, omega_si, machin_si):
-                    return _done(res, t0)
-                res.message = (f"the steady branch could not be continued beyond M = "
-                               f"{cur.machin:.6g} (a sharp turn, or a fold without a real "
-                               f"eigenvalue going to zero), stable up to there")
-                res.bracket = (cur.machin, math.nan)
-                return _done(res, t0)
-            continue
-        pn = record(nxt)
-        if pn.leading.real >= 0.0:
-            return _refine(frame, res, cur, p, nxt, pn, rtol, record, t0, omega_si, machin_si)
-        prev, cur, prev_p, p = cur, nxt, p, pn
-        f = min(factor, f * f) if nxt.iterations <= 5 else f
+    prev_p = None
+    try:
+        for nxt in march(frame, cur, m_max, factor):
+            pn = record(nxt)
+            if pn.leading.real >= 0.0:
+                return _refine(frame, res, cur, p, nxt, pn, rtol, record, t0, omega_si, machin_si)
+            cur, prev_p, p = nxt, p, pn
+    except BranchLost as lost:
+        if _fold(res, prev_p, p, cur, lost.m_failed, omega_si, machin_si):
+            return _done(res, t0)
+        res.message = (f"the steady branch could not be continued beyond M = {cur.machin:.6g} "
+                       f"(a sharp turn, or a fold without a real eigenvalue going to zero), "
+                       f"stable up to there")
+        res.bracket = (cur.machin, math.nan)
+        return _done(res, t0)
     res.message = f"stable up to M = {m_max:g} (no crossing in the range scanned: raise --m-max)"
     res.bracket = (cur.machin, math.nan)
     return _done(res, t0)
