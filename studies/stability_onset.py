@@ -145,11 +145,7 @@ def protocol():
           "largest rise above it [L] | final rise [L] |")
     print("|---:|---|---:|---:|---:|---:|")
     for M in (546.2, 572.5, 579.2, 600.0, 630.0):
-        cfg = config(M, (Phase("ccw", 5.0, 1.0), Phase("cw", 10.0, 1.0)))
-        base_sys = RodSystem(cfg)
-        frame = RotatingFrame(base_sys, -1.0)
-        r, st = steady(frame, [M])
-        x = base_sys.unpack(frame.full(st[M].z))[0]
+        cfg, frame, r, _, _, _, x = on_whirl(M, (Phase("ccw", 5.0, 1.0), Phase("cw", 10.0, 1.0)))
         tr = Simulation(cfg).run()
         t, dev, rise = deviation(frame, tr, x)
         cw = t > 5 * TWO_PI
@@ -170,11 +166,7 @@ def verdict():
           "deviation from the steady CW state [L] at CW turn 5 / 10 / 20 / 30 |")
     print("|---:|---|---|---:|---|---|")
     for M in (579.2, 600.0):
-        cfg = config(M, (Phase("ccw", 5.0, 1.0), Phase("cw", 30.0, 1.0)))
-        base_sys = RodSystem(cfg)
-        frame = RotatingFrame(base_sys, -1.0)
-        r, st = steady(frame, [M])
-        x = base_sys.unpack(frame.full(st[M].z))[0]
+        cfg, frame, r, _, _, _, x = on_whirl(M, (Phase("ccw", 5.0, 1.0), Phase("cw", 30.0, 1.0)))
         tr = Simulation(cfg).run()
         path = f"out/stability/verdict_M{M:g}.nc"
         write_run(tr, path)
