@@ -162,3 +162,14 @@ def test_growth_rate_in_the_lab_frame_integrator_is_the_leading_eigenvalue(cw31,
     rate = np.polyfit(tm, logd, 1)[0]
     assert rate == pytest.approx(lam.real, rel=0.25)
     assert np.sign(rate) == np.sign(ratio - 1)
+
+
+def test_arnoldi_finds_the_dense_leading_eigenvalues(cw31):
+    # long chains use shift-invert ARPACK around 0: the slow modes it returns must be the
+    # dense spectrum's leading ones (to ARPACK's tolerance, ~1e-10 relative here)
+    frame, r = cw31
+    st = branch(frame, [0.8 * r.machin_c])[0.8 * r.machin_c]
+    dense = spectrum(frame, st, method="dense").values
+    arn = spectrum(frame, st, method="arnoldi", k=8).values
+    for lam in dense[:4]:
+        assert np.min(np.abs(arn - lam)) < 1e-8 * max(1.0, abs(lam))
