@@ -1,0 +1,227 @@
+"""The Rotne-Prager-Yamakawa mobility of spheres of different radii (filament beads and body
+blobs together).
+
+Zuk, Wajnryb, Mizerski & Szymczak, "Rotne-Prager-Yamakawa approximation for different-sized
+particles in application to macromolecular bead models", J. Fluid Mech. 741, R5 (2014),
+Eqs. (10)-(12), viscosity 1. For spheres i, j of radii ``a_i``, ``a_j`` at distance ``r``:
+
+* apart (``r > a_i + a_j``):
+  ``mu_ij = 1/(8 pi r) [(1 + (a_i^2 + a_j^2)/(3 r^2)) I + (1 - (a_i^2 + a_j^2)/r^2) rr]``;
+* overlapping (``|a_i - a_j| < r <= a_i + a_j``):
+  ``mu_ij = 1/(6 pi a_i a_j) [(16 r^3 (a_i + a_j) - ((a_i - a_j)^2 + 3 r^2)^2)/(32 r^3) I
+  + 3 ((a_i - a_j)^2 - r^2)^2/(32 r^3) rr]``;
+* one inside the other (``r <= |a_i - a_j|``): ``mu_ij = I / (6 pi max(a_i, a_j))``;
+* self: ``I / (6 pi a_i)``.
+
+With equal radii these are the equal-size RPY tensor of :mod:`flagwrap.hydrodynamics._kernels`
+(tested to rounding). The matrix is positive definite for every configuration, which is the
+reason for this regularisation (Zuk et al.). It is continuous at ``r = a_i + a_j`` and at
+``r = |a_i - a_j|``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+
+@nb.njit(cache=True, inline="always")
+def _pair(r, ai, aj):
+    """``(f, g)`` with ``mu_ij = f I + g rr`` (viscosity 1)."""
+    if r > ai + aj:
+        s2 = (ai * ai + aj * aj) / (r * r)
+        c = 1.0 / (8.0 * math.pi * r)
+        return c * (1.0 + s2 / 3.0), c * (1.0 - s2)
+    d = ai - aj
+    if r > abs(d):
+        c = 1.0 / (6.0 * math.pi * ai * aj * 32.0 * r * r * r)
+        q = d * d + 3.0 * r * r
+        e = d * d - r * r
+        return c * (16.0 * r * r * r * (ai + aj) - q * q), c * 3.0 * e * e
+    return 1.0 / (6.0 * math.pi * max(ai, aj)), 0.0
+
+
+@nb.njit(cache=True)
+def rpy_matrix_radii(x, radii, out):
+    """Fill ``out`` (3n, 3n) with the mobility of spheres at ``x`` (n, 3) of ``radii`` (n,)."""
+    n = x.shape[0]
+    for i in range(n):
+        s = 1.0 / (6.0 * math.pi * radii[i])
+        for k in range(3):
+            for m in range(3):
+                out[3 * i + k, 3 * i + m] = s if k == m else 0.0
+        for j in range(i + 1, n):
+            d0 = x[i, 0] - x[j, 0]
+            d1 = x[i, 1] - x[j, 1]
+            d2 = x[i, 2] - x[j, 2]
+            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            f, g = _pair(r, radii[i], radii[j])
+            if r > 0.0:
+                u0, u1, u2 = d0 / r, d1 / r, d2 / r
+            else:
+                u0, u1, u2 = 0.0, 0.0, 0.0
+            u = (u0, u1, u2)
+            for k in range(3):
+                for m in range(3):
+                    v = g * u[k] * u[m]
+                    if k == m:
+                        v += f
+                    out[3 * i + k, 3 * j + m] = v
+                    out[3 * j + m, 3 * i + k] = v
+
+
+@nb.njit(cache=True)
+def rpy_apply_radii(x, radii, F, out):
+    """``out = mu F`` for spheres of ``radii`` (O(n^2), no matrix)."""
+    n = x.shape[0]
+    for i in range(n):
+        s = 1.0 / (6.0 * math.pi * radii[i])
+        out[i, 0] = s * F[i, 0]
+        out[i, 1] = s * F[i, 1]
+        out[i, 2] = s * F[i, 2]
+    for i in range(n):
+        for j in range(i + 1, n):
+            d0 = x[i, 0] - x[j, 0]
+            d1 = x[i, 1] - x[j, 1]
+            d2 = x[i, 2] - x[j, 2]
+            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            f, g = _pair(r, radii[i], radii[j])
+            if r > 0.0:
+                u0, u1, u2 = d0 / r, d1 / r, d2 / r
+            else:
+                u0, u1, u2 = 0.0, 0.0, 0.0
+            uFj = u0 * F[j, 0] + u1 * F[j, 1] + u2 * F[j, 2]
+            uFi = u0 * F[i, 0] + u1 * F[i, 1] + u2 * F[i, 2]
+            out[i, 0] += f * F[j, 0] + g * uFj * u0
+            out[i, 1] += f * F[j, 1] + g * uFj * u1
+            out[i, 2] += f * F[j, 2] + g * uFj * u2
+            out[j, 0] += f * F[i, 0] + g * uFi * u0
+            out[j, 1] += f * F[i, 1] + g * uFi * u1
+            out[j, 2] += f * F[i, 2] + g * uFi * u2
+
+
+class PolydisperseRPY:
+    """RPY mobility of spheres with per-sphere radii (viscosity 1): ``matrix(x)``,
+    ``apply(x, F)``."""
+
+    long_range = True
+
+    def __init__(self, radii):
+        self.radii = np.ascontiguousarray(radii, dtype=np.float64)
+        if not (self.radii.ndim == 1 and np.all(self.radii > 0) and np.all(np.isfinite(self.radii))):
+            raise ValueError("radii must be a 1-D array of finite positive numbers")
+
+    def matrix(self, x, out=None):
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        n = len(x)
+        if out is None:
+            out = np.empty((3 * n, 3 * n))
+        rpy_matrix_radii(x, self.radii, out)
+        return out
+
+    def apply(self, x, F):
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        F = np.ascontiguousarray(F, dtype=np.float64)
+        out = np.empty_like(F)
+        rpy_apply_radii(x, self.radii, F, out)
+        return out
+
+
+@nb.njit(cache=True)
+def rpy_cross_radii(x, a, y, b, out):
+    """``out`` (3n, 3m): the mobility block between spheres at ``x`` (radius ``a`` each) and
+    spheres at ``y`` of radii ``b`` (m,)."""
+    for i in range(x.shape[0]):
+        for j in range(y.shape[0]):
+            d0 = x[i, 0] - y[j, 0]
+            d1 = x[i, 1] - y[j, 1]
+            d2 = x[i, 2] - y[j, 2]
+            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            f, g = _pair(r, a, b[j])
+            if r > 0.0:
+                u0, u1, u2 = d0 / r, d1 / r, d2 / r
+            else:
+                u0, u1, u2 = 0.0, 0.0, 0.0
+            u = (u0, u1, u2)
+            for k in range(3):
+                for m in range(3):
+                    v = g * u[k] * u[m]
+                    if k == m:
+                        v += f
+                    out[3 * i + k, 3 * j + m] = v
+
+
+class FixedBodyMobility:
+    """The beads' mobility beside a fixed body with a no-slip surface (rigid multiblob,
+    :mod:`flagwrap.body.multiblob`).
+
+    The body's blobs carry forces ``lambda`` that hold its surface still. A bead force ``F``
+    moves the blobs at ``M_bf F``, so ``M_bb lambda = -M_bf F``, and the beads move at
+    ``(M_ff - M_fb M_bb^-1 M_bf) F``. That Schur complement is the mobility here. ``M_bb`` is
+    factorised once, since the body does not move. It is symmetric and positive definite, and
+    smaller than ``M_ff``: the surface screens the flow. Viscosity 1; the bead radius is one
+    number, the blobs' radii per blob.
+    """
+
+    long_range = True
+    backend = "direct+fixed-body"
+
+    def __init__(self, radius: float, blobs, blob_radii):
+        import scipy.linalg as sl
+
+        from flagwrap.hydrodynamics.mobility import RPYMobility
+
+        self.radius = float(radius)
+        self.self_mobility = 1.0 / (6.0 * math.pi * self.radius)
+        self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
+        self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
+                                               dtype=np.float64)
+        self._free = RPYMobility(self.radius)
+        Mbb = PolydisperseRPY(self.blob_radii).matrix(self.blobs)
+        self._chol = sl.cho_factor(Mbb, lower=True, check_finite=False)
+
+    def _cross(self, x):
+        out = np.empty((3 * len(x), 3 * len(self.blobs)))
+        rpy_cross_radii(np.ascontiguousarray(x, dtype=np.float64), self.radius, self.blobs,
+                        self.blob_radii, out)
+        return out
+
+    def screening(self, x) -> np.ndarray:
+        """``M_fb M_bb^-1 M_bf`` (3n, 3n): what the body takes off the free mobility."""
+        import scipy.linalg as sl
+
+        C = self._cross(x)
+        L = self._chol[0]
+        Y = sl.solve_triangular(L, C.T, lower=True, check_finite=False)
+        return Y.T @ Y
+
+    def matrix(self, x, out=None):
+        M = self._free.matrix(x, out=out)
+        M -= self.screening(x)
+        return M
+
+    def apply(self, x, F):
+        import scipy.linalg as sl
+
+        F = np.ascontiguousarray(F, dtype=np.float64)
+        C = self._cross(x)
+        lam = sl.cho_solve(self._chol, C.T @ F.ravel(), check_finite=False)
+        return self._free.apply(x, F) - (C @ lam).reshape(-1, 3)
+
+    def apply_single(self, x, F):
+        return self.apply(x, F)
+
+    def near_field_blocks(self, x, width: int):
+        """Bead-bead blocks of the screened mobility along the chain (for banded
+        preconditioners), from the dense matrix."""
+        n = len(x)
+        M = self.matrix(x)
+        out = np.zeros((n, 2 * width + 1, 3, 3))
+        for i in range(n):
+            for k in range(-width, width + 1):
+                j = i + k
+                if 0 <= j < n:
+                    out[i, width + k] = M[3 * i:3 * i + 3, 3 * j:3 * j + 3]
+        return out
