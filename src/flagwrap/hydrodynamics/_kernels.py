@@ -47,18 +47,40 @@ def rpy_matrix(x, a, out):
             d2 = x[i, 2] - x[j, 2]
             r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
             f, g = _pair(r, a)
-            if r > 0.0:
-                u0, u1, u2 = d0 / r, d1 / r, d2 / r
-            else:
-                u0, u1, u2 = 0.0, 0.0, 0.0
-            u = (u0, u1, u2)
-            for k in range(3):
-                for m in range(3):
-                    v = g * u[k] * u[m]
-                    if k == m:
-                        v += f
-                    out[3 * i + k, 3 * j + m] = v
-                    out[3 * j + m, 3 * i + k] = v
+            store_pair_block(out, i, j, f, g, d0, d1, d2, r, True)
+
+
+@nb.njit(cache=True, inline="always")
+def add_pair_product(out, F, i, j, f, g, u0, u1, u2):
+    """``out_i += (f I + g uu) F_j`` and ``out_j += (f I + g uu) F_i`` for one pair."""
+    uj = u0 * F[j, 0] + u1 * F[j, 1] + u2 * F[j, 2]
+    ui = u0 * F[i, 0] + u1 * F[i, 1] + u2 * F[i, 2]
+    out[i, 0] += f * F[j, 0] + g * uj * u0
+    out[i, 1] += f * F[j, 1] + g * uj * u1
+    out[i, 2] += f * F[j, 2] + g * uj * u2
+    out[j, 0] += f * F[i, 0] + g * ui * u0
+    out[j, 1] += f * F[i, 1] + g * ui * u1
+    out[j, 2] += f * F[i, 2] + g * ui * u2
+
+
+@nb.njit(cache=True, inline="always")
+def store_pair_block(out, i, j, f, g, d0, d1, d2, r, symmetric):
+    """Write the 3x3 block ``f I + g uu`` (``u = d / r``, 0 for coincident points) of pair
+    ``(i, j)`` into ``out`` at rows ``3i``, columns ``3j``, and its transpose at ``(3j, 3i)``
+    when ``symmetric``."""
+    if r > 0.0:
+        u0, u1, u2 = d0 / r, d1 / r, d2 / r
+    else:
+        u0, u1, u2 = 0.0, 0.0, 0.0
+    u = (u0, u1, u2)
+    for k in range(3):
+        for m in range(3):
+            v = g * u[k] * u[m]
+            if k == m:
+                v += f
+            out[3 * i + k, 3 * j + m] = v
+            if symmetric:
+                out[3 * j + m, 3 * i + k] = v
 
 
 @nb.njit(cache=True, inline="always")
@@ -368,11 +390,4 @@ def rpy_overlap_correction(x, a, pairs, F, out):
         gn = s * (3.0 * r / (32.0 * a))
         df = fn - ff
         dg = (gn - gf) / (r * r)
-        dj = d0 * F[j, 0] + d1 * F[j, 1] + d2 * F[j, 2]
-        di = d0 * F[i, 0] + d1 * F[i, 1] + d2 * F[i, 2]
-        out[i, 0] += df * F[j, 0] + dg * dj * d0
-        out[i, 1] += df * F[j, 1] + dg * dj * d1
-        out[i, 2] += df * F[j, 2] + dg * dj * d2
-        out[j, 0] += df * F[i, 0] + dg * di * d0
-        out[j, 1] += df * F[i, 1] + dg * di * d1
-        out[j, 2] += df * F[i, 2] + dg * di * d2
+        add_pair_product(out, F, i, j, df, dg, d0, d1, d2)

@@ -26,6 +26,8 @@ import math
 import numba as nb
 import numpy as np
 
+from flagwrap.hydrodynamics._kernels import add_pair_product, store_pair_block
+
 
 @nb.njit(cache=True, inline="always")
 def _pair(r, ai, aj):
@@ -43,33 +45,26 @@ def _pair(r, ai, aj):
     return 1.0 / (6.0 * math.pi * max(ai, aj)), 0.0
 
 
+@nb.njit(cache=True, inline="always")
+def _sep(p, i, q, j):
+    """``(d0, d1, d2, r)``: the vector from ``q[j]`` to ``p[i]`` and its length."""
+    d0 = p[i, 0] - q[j, 0]
+    d1 = p[i, 1] - q[j, 1]
+    d2 = p[i, 2] - q[j, 2]
+    return d0, d1, d2, math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
 @nb.njit(cache=True)
 def rpy_matrix_radii(x, radii, out):
     """Fill ``out`` (3n, 3n) with the mobility of spheres at ``x`` (n, 3) of ``radii`` (n,)."""
     n = x.shape[0]
     for i in range(n):
-        s = 1.0 / (6.0 * math.pi * radii[i])
-        for k in range(3):
-            for m in range(3):
-                out[3 * i + k, 3 * i + m] = s if k == m else 0.0
+        store_pair_block(out, i, i, 1.0 / (6.0 * math.pi * radii[i]), 0.0, 0.0, 0.0, 0.0, 0.0,
+                         False)
         for j in range(i + 1, n):
-            d0 = x[i, 0] - x[j, 0]
-            d1 = x[i, 1] - x[j, 1]
-            d2 = x[i, 2] - x[j, 2]
-            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            d0, d1, d2, r = _sep(x, i, x, j)
             f, g = _pair(r, radii[i], radii[j])
-            if r > 0.0:
-                u0, u1, u2 = d0 / r, d1 / r, d2 / r
-            else:
-                u0, u1, u2 = 0.0, 0.0, 0.0
-            u = (u0, u1, u2)
-            for k in range(3):
-                for m in range(3):
-                    v = g * u[k] * u[m]
-                    if k == m:
-                        v += f
-                    out[3 * i + k, 3 * j + m] = v
-                    out[3 * j + m, 3 * i + k] = v
+            store_pair_block(out, i, j, f, g, d0, d1, d2, r, True)
 
 
 @nb.njit(cache=True)
@@ -83,23 +78,13 @@ def rpy_apply_radii(x, radii, F, out):
         out[i, 2] = s * F[i, 2]
     for i in range(n):
         for j in range(i + 1, n):
-            d0 = x[i, 0] - x[j, 0]
-            d1 = x[i, 1] - x[j, 1]
-            d2 = x[i, 2] - x[j, 2]
-            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            d0, d1, d2, r = _sep(x, i, x, j)
             f, g = _pair(r, radii[i], radii[j])
             if r > 0.0:
                 u0, u1, u2 = d0 / r, d1 / r, d2 / r
             else:
                 u0, u1, u2 = 0.0, 0.0, 0.0
-            uFj = u0 * F[j, 0] + u1 * F[j, 1] + u2 * F[j, 2]
-            uFi = u0 * F[i, 0] + u1 * F[i, 1] + u2 * F[i, 2]
-            out[i, 0] += f * F[j, 0] + g * uFj * u0
-            out[i, 1] += f * F[j, 1] + g * uFj * u1
-            out[i, 2] += f * F[j, 2] + g * uFj * u2
-            out[j, 0] += f * F[i, 0] + g * uFi * u0
-            out[j, 1] += f * F[i, 1] + g * uFi * u1
-            out[j, 2] += f * F[i, 2] + g * uFi * u2
+            add_pair_product(out, F, i, j, f, g, u0, u1, u2)
 
 
 class PolydisperseRPY:
@@ -135,22 +120,9 @@ def rpy_cross_radii(x, a, y, b, out):
     spheres at ``y`` of radii ``b`` (m,)."""
     for i in range(x.shape[0]):
         for j in range(y.shape[0]):
-            d0 = x[i, 0] - y[j, 0]
-            d1 = x[i, 1] - y[j, 1]
-            d2 = x[i, 2] - y[j, 2]
-            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            d0, d1, d2, r = _sep(x, i, y, j)
             f, g = _pair(r, a, b[j])
-            if r > 0.0:
-                u0, u1, u2 = d0 / r, d1 / r, d2 / r
-            else:
-                u0, u1, u2 = 0.0, 0.0, 0.0
-            u = (u0, u1, u2)
-            for k in range(3):
-                for m in range(3):
-                    v = g * u[k] * u[m]
-                    if k == m:
-                        v += f
-                    out[3 * i + k, 3 * j + m] = v
+            store_pair_block(out, i, j, f, g, d0, d1, d2, r, False)
 
 
 class FixedBodyMobility:
