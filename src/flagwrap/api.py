@@ -243,7 +243,8 @@ def bacteria(prefactor: float = 0.06, files=(), only_files: bool = False) -> lis
 
 
 class CallableModule(__import__("types").ModuleType):
-    """Module type of the packages ``flagwrap.sweep`` and ``flagwrap.bacteria``, whose names are
+    """Module type of the packages ``flagwrap.sweep``, ``flagwrap.bacteria`` and
+    ``flagwrap.stability``, whose names are
     also API functions: importing a subpackage binds its name on ``flagwrap`` to the module, so
     the module itself answers the call (``flagwrap.sweep(spec)`` runs :func:`sweep`)."""
 
@@ -253,5 +254,5 @@ class CallableModule(__import__("types").ModuleType):
         return getattr(api, self.__name__.rsplit(".", 1)[1])(*args, **kwargs)
 
 
-__all__ = ["load", "run", "RunResult", "analyze", "critical", "CriticalResult", "sweep", "figure",
-           "bacteria"]
+__all__ = ["load", "run", "RunResult", "analyze", "critical", "CriticalResult", "stability", "sweep",
+           "figure", "bacteria"]

@@ -264,8 +264,13 @@ def test_python_api_is_exported_and_checks_input(tmp_path):
     import flagwrap
     from flagwrap.errors import UserInputError
 
-    for name in ("run", "analyze", "critical", "sweep", "figure", "bacteria", "load"):
+    for name in ("run", "analyze", "critical", "stability", "sweep", "figure", "bacteria", "load"):
         assert callable(getattr(flagwrap, name))
+    import flagwrap.stability.threshold  # noqa: F401  (binds the subpackage on flagwrap)
+
+    assert callable(flagwrap.stability)  # the package answers the API call
+    with pytest.raises(UserInputError, match="--rtol"):
+        flagwrap.stability("fig4a", rtol=2.0)
     with pytest.raises(UserInputError, match="--cw-turns"):
         flagwrap.critical("fig4a", cw_turns=3, cache=tmp_path)
     with pytest.raises(UserInputError, match="unknown figure"):
