@@ -173,3 +173,24 @@ def test_arnoldi_finds_the_dense_leading_eigenvalues(cw31):
     arn = spectrum(frame, st, method="arnoldi", k=8).values
     for lam in dense[:4]:
         assert np.min(np.abs(arn - lam)) < 1e-8 * max(1.0, abs(lam))
+
+
+def test_a_buoyant_helix_starts_by_switching_gravity_on_in_steps():
+    # 2 % lighter than the fluid (G = 18.6): the static shape lifts far from the rest shape,
+    # by an amount that does not shrink with M, so Newton from the rest shape fails at every
+    # M; the gravity homotopy of start_state reaches the steady state, a true fixed point
+    from flagwrap.stability.steady import NewtonFailure, start_state
+
+    cfg = small(n_beads=31)
+    cfg = cfg.replace(filament=dataclasses.replace(cfg.filament, density=None,
+                                                   density_mismatch=-0.02, turns=None,
+                                                   pitch_angle_deg=None))
+    frame = RotatingFrame(RodSystem(cfg), -1.0)
+    z, base = initial_guess(frame)
+    with pytest.raises(NewtonFailure):
+        newton(frame, 10.0, z, base)
+    g0 = frame.system.gravity.copy()
+    st = start_state(frame, 10.0)
+    np.testing.assert_array_equal(frame.system.gravity, g0)  # gravity restored
+    f, _ = frame.velocity(st.z, st.base, st.machin)
+    assert st.converged and np.max(np.abs(f)) < 1e-9

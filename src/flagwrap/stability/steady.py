@@ -168,13 +168,53 @@ def march(frame, cur: SteadyState, m_stop: float, factor: float = 1.25, prev=Non
         f = min(factor, f * f) if nxt.iterations <= 5 else f
 
 
+def start_state(frame, machin: float, halvings: int = 8) -> SteadyState:
+    """The first steady state of a branch: Newton from the rest shape at ``machin``, halving
+    ``machin`` up to ``halvings`` times where it fails. Where it still fails and the system
+    has gravity, the gravity is switched on in steps (a homotopy: 1/8, 2/8, ... of it, a step
+    halved where Newton fails). A buoyant helix sags or lifts far from its rest shape, by an
+    amount that does not shrink with M. Raises :class:`NewtonFailure`."""
+    z, base = initial_guess(frame)
+    m = float(machin)
+    last = None
+    for _ in range(halvings + 1):
+        try:
+            return newton(frame, m, z, base)
+        except NewtonFailure as exc:
+            last = exc
+            m /= 2.0
+    g = frame.system.gravity
+    if not np.any(g):
+        raise last
+    g0 = g.copy()
+    m = float(machin)
+    try:
+        done, step = 0.0, 0.125
+        state = None
+        while done < 1.0:
+            nxt = min(1.0, done + step)
+            g[:] = g0 * nxt
+            try:
+                state = newton(frame, m, z if state is None else state.z,
+                               base if state is None else state.base)
+            except NewtonFailure:
+                step /= 2.0
+                if step < 1e-3:
+                    raise
+                continue
+            done = nxt
+            step = min(0.25, 2.0 * step)
+        return state
+    finally:
+        g[:] = g0
+
+
 def branch(frame, machins, m_start: float = 10.0, factor: float = 1.25) -> dict:
     """Steady states at each of ``machins``, by continuation (:func:`march`) from the rest
     shape at ``m_start``. Returns ``{M: SteadyState}``; raises :class:`BranchLost` where the
     branch is lost."""
     targets = sorted(float(m) for m in machins)
-    z, base = initial_guess(frame)
-    cur = newton(frame, min(float(m_start), targets[0]), z, base)
+    cur = start_state(frame, min(float(m_start), targets[0]))
     prev = None
     out = {}
     for target in targets:

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 from flagwrap.stability.spectrum import spectrum
 from flagwrap.stability.steady import (BranchLost, NewtonFailure, extrapolate, initial_guess,
-                                       march, newton)
+                                       march, newton, start_state)
 
 DIRECTIONS = {"ccw": 1.0, "cw": -1.0}
 
@@ -123,18 +123,15 @@ def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: floa
             on_point(p)
         return p
 
-    # the first state: Newton from the rest shape, at a smaller M if it must
-    cur = None
-    m = float(m_start)
-    for _ in range(8):
-        try:
-            cur = newton(frame, m, z, base)
-            break
-        except NewtonFailure:
-            m /= 2.0
-    if cur is None:
+    # the first state: Newton from the rest shape, at a smaller M or by switching gravity on
+    # in steps if it must
+    try:
+        cur = start_state(frame, m_start, halvings=7)
+    except NewtonFailure:
         res.message = (f"no steady state found from the rest shape at M = {m_start:g} down to "
-                       f"{m * 2:g} (Newton did not converge)")
+                       f"{m_start / 2**7:g} (Newton did not converge"
+                       + (", also with gravity switched on in steps" if frame.system.gravity.any()
+                          else "") + ")")
         return _done(res, t0)
     p = record(cur)
     if p.leading.real >= 0.0:
