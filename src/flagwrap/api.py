@@ -179,21 +179,15 @@ def stability(config, direction: str = "cw", m_start: float = 10.0, m_max=None,
 
     from flagwrap.cli.stability import check_options
     from flagwrap.errors import UserInputError
-    from flagwrap.stability.threshold import DIRECTIONS, find_critical
-    from flagwrap.system.rod_system import RodSystem
-    from flagwrap.system.rotating import RotatingFrame
+    from flagwrap.stability.threshold import DIRECTIONS, critical_from_config
 
     if direction not in DIRECTIONS:
         raise UserInputError(f"direction must be 'cw' or 'ccw', got {direction!r}")
     check_options(argparse.Namespace(m_start=m_start, m_max=m_max, rtol=rtol, factor=factor,
                                      mode=None, vtk=None))
     cfg = _with_numerics(load(config), hydrodynamics)
-    m_max = 20.0 * cfg.machin_critical_scaling if m_max is None else m_max
-    if not m_max > m_start:
-        raise UserInputError(f"m_max must be above m_start ({m_start:g}), got {m_max:g}")
-    frame = RotatingFrame(RodSystem(cfg), DIRECTIONS[direction])
-    return find_critical(frame, m_start=m_start, m_max=m_max, factor=factor, rtol=rtol,
-                         on_point=on_point, omega_si=cfg.omega, machin_si=cfg.machin)
+    return critical_from_config(cfg, direction, m_start=m_start, m_max=m_max, factor=factor,
+                                rtol=rtol, on_point=on_point)
 
 
 def sweep(spec, out="out/sweeps", scheduler: str = "local", workers=None,

@@ -98,9 +98,7 @@ def run(args) -> int:
     import sys
 
     from flagwrap.io.config import load_config
-    from flagwrap.stability.threshold import DIRECTIONS, find_critical
-    from flagwrap.system.rod_system import RodSystem
-    from flagwrap.system.rotating import RotatingFrame
+    from flagwrap.stability.threshold import critical_from_config, resolve_m_max
 
     check_options(args)
     if getattr(args, "sweep", False):
@@ -108,13 +106,7 @@ def run(args) -> int:
     cfg = load_config(args.config)
     if args.no_hi:
         cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
-    m_max = args.m_max if args.m_max is not None else 20.0 * cfg.machin_critical_scaling
-    if not m_max > args.m_start:
-        from flagwrap.errors import UserInputError
-
-        raise UserInputError(f"--m-max must be above --m-start ({args.m_start:g}); the default "
-                             f"20x the scaling line is {m_max:g} here: give --m-max")
-    frame = RotatingFrame(RodSystem(cfg), DIRECTIONS[args.direction])  # refuses a bad system
+    m_max = resolve_m_max(cfg, args.m_start, args.m_max)
     bar = _bar(not (args.json or args.no_progress) and sys.stderr.isatty(), args.m_start, m_max)
 
     def show(p):
@@ -124,13 +116,12 @@ def run(args) -> int:
             bar.refresh()
 
     try:
-        res = find_critical(frame, m_start=args.m_start, m_max=m_max, factor=args.factor,
-                            rtol=args.rtol, on_point=show, omega_si=cfg.omega,
-                            machin_si=cfg.machin)
+        res = critical_from_config(cfg, args.direction, m_start=args.m_start, m_max=m_max,
+                                   factor=args.factor, rtol=args.rtol, on_point=show)
     finally:
         if bar is not None:
             bar.close()
-    files = _write_mode(frame, res, cfg, args)
+    files = _write_mode(res, cfg, args)
     s = res.summary()
     s.update(config=str(args.config), hydrodynamics=cfg.numerics.hydrodynamics,
              machin_critical_scaling=cfg.machin_critical_scaling, m_start=args.m_start,
@@ -170,7 +161,7 @@ def run(args) -> int:
     return 0
 
 
-def _write_mode(frame, res, cfg, args) -> list:
+def _write_mode(res, cfg, args) -> list:
     """The optional plot and VTK file of the critical mode (nothing when not converged)."""
     if res.state is None or not (args.mode or args.vtk):
         return []
@@ -178,9 +169,9 @@ def _write_mode(frame, res, cfg, args) -> list:
 
     from flagwrap.stability.spectrum import mode_positions, spectrum
 
-    sp = spectrum(frame, res.state, vectors=True)
+    sp = spectrum(res.frame, res.state, vectors=True)
     k = int(np.argmin(np.abs(sp.values - res.eigenvalue)))  # the critical one (a fold's is real)
-    mode = mode_positions(frame, sp.vectors[:, k])
+    mode = mode_positions(res.frame, sp.vectors[:, k])
     x = res.state.info.x
     L = cfg.filament.length
     files = []

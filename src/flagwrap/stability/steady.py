@@ -98,6 +98,7 @@ def newton(frame, machin: float, z0: np.ndarray, base0, step_tol: float = 1e-10,
     base = base0
     n3 = frame.n3
     step = math.inf
+    converged = False
     for it in range(1, max_iter + 1):
         f, info = frame.velocity(z, base, machin)
         base = info.frames  # the chart at z itself (a change of chart moves nothing)
@@ -115,12 +116,13 @@ def newton(frame, machin: float, z0: np.ndarray, base0, step_tol: float = 1e-10,
             break
         z = retract(frame, z, dz)
         if step < step_tol:
-            f, info = frame.velocity(z, base, machin)
-            return SteadyState(z, info.frames, float(machin), float(np.max(np.abs(f))), step,
-                               it, True, info)
+            converged = True
+            break
     f, info = frame.velocity(z, base, machin)
     state = SteadyState(z, info.frames, float(machin), float(np.max(np.abs(f))), step,
-                        it, False, info)
+                        it, converged, info)
+    if converged:
+        return state
     raise NewtonFailure(f"Newton did not converge at M = {machin:.6g} (last step {step:.2e} L "
                         f"after {it} iterations)", state)
 

@@ -28,8 +28,7 @@ import math
 from dataclasses import dataclass, field
 
 from flagwrap.stability.spectrum import spectrum
-from flagwrap.stability.steady import (BranchLost, NewtonFailure, extrapolate, initial_guess,
-                                       march, newton, start_state)
+from flagwrap.stability.steady import BranchLost, NewtonFailure, extrapolate, march, newton, start_state
 
 DIRECTIONS = {"ccw": 1.0, "cw": -1.0}
 
@@ -72,6 +71,7 @@ class StabilityResult:
     tip_z0: float = math.nan
     branch: list = field(default_factory=list)
     state: object = field(default=None, repr=False)  # steady state at the top of the bracket
+    frame: object = field(default=None, repr=False)  # the RotatingFrame it was computed in
     wall_time: float = 0.0
 
     def summary(self) -> dict:
@@ -112,9 +112,15 @@ def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: floa
 
     t0 = time.perf_counter()
     direction = "ccw" if frame.omega > 0 else "cw"
-    res = StabilityResult(direction, False, "")
-    z, base = initial_guess(frame)
+    res = StabilityResult(direction, False, "", frame=frame)
     res.tip_z0 = float(frame.system.x0[-1, 2])
+
+    def done():
+        if res.converged and omega_si is not None and machin_si:
+            res.omega_c = abs(omega_si) * res.machin_c / machin_si
+            res.frequency_c = res.omega_c / (2 * math.pi)
+        res.wall_time = time.perf_counter() - t0
+        return res
 
     def record(state):
         p = _point(frame, state)
@@ -132,34 +138,35 @@ def find_critical(frame, m_start: float = 10.0, m_max: float = 1e4, factor: floa
                        f"{m_start / 2**7:g} (Newton did not converge"
                        + (", also with gravity switched on in steps" if frame.system.gravity.any()
                           else "") + ")")
-        return _done(res, t0)
+        return done()
     p = record(cur)
     if p.leading.real >= 0.0:
         res.message = (f"the steady state is already unstable at M = {cur.machin:.4g} (leading "
                        f"eigenvalue {p.leading.real:+.3g} {abs(p.leading.imag):+.3g}i): "
                        f"lower --m-start")
-        return _done(res, t0)
+        return done()
     prev_p = None
     try:
         for nxt in march(frame, cur, m_max, factor):
             pn = record(nxt)
             if pn.leading.real >= 0.0:
-                return _refine(frame, res, cur, p, nxt, pn, rtol, record, t0, omega_si, machin_si)
+                _refine(frame, res, cur, p, nxt, pn, rtol, record)
+                return done()
             cur, prev_p, p = nxt, p, pn
     except BranchLost as lost:
-        if _fold(res, prev_p, p, cur, lost.m_failed, omega_si, machin_si):
-            return _done(res, t0)
+        if _fold(res, prev_p, p, cur, lost.m_failed):
+            return done()
         res.message = (f"the steady branch could not be continued beyond M = {cur.machin:.6g} "
                        f"(a sharp turn, or a fold without a real eigenvalue going to zero), "
                        f"stable up to there")
         res.bracket = (cur.machin, math.nan)
-        return _done(res, t0)
+        return done()
     res.message = f"stable up to M = {m_max:g} (no crossing in the range scanned: raise --m-max)"
     res.bracket = (cur.machin, math.nan)
-    return _done(res, t0)
+    return done()
 
 
-def _refine(frame, res, lo, plo, hi, phi, rtol, record, t0, omega_si, machin_si):
+def _refine(frame, res, lo, plo, hi, phi, rtol, record) -> None:
     while hi.machin / lo.machin - 1.0 > rtol:
         mid = math.sqrt(lo.machin * hi.machin)
         try:
@@ -185,13 +192,9 @@ def _refine(frame, res, lo, plo, hi, phi, rtol, record, t0, omega_si, machin_si)
     res.state = hi
     res.converged = True
     res.message = "converged"
-    if omega_si is not None and machin_si:
-        res.omega_c = abs(omega_si) * res.machin_c / machin_si
-        res.frequency_c = res.omega_c / (2 * math.pi)
-    return _done(res, t0)
 
 
-def _fold(res, pa, pb, state, m_failed, omega_si, machin_si) -> bool:
+def _fold(res, pa, pb, state, m_failed) -> bool:
     """A fold (saddle-node) of the branch: Newton fails just beyond ``pb`` while the leading
     eigenvalue is real, negative and shrinking towards zero. Near a fold it goes as
     ``sqrt(M_f - M)``, so ``lambda^2`` is linear in ``M``. Its zero from the last two points
@@ -216,25 +219,35 @@ def _fold(res, pa, pb, state, m_failed, omega_si, machin_si) -> bool:
     res.message = (f"the steady branch folds: a real eigenvalue goes to zero "
                    f"({la:+.3g} at M = {pa.machin:.5g}, {lb:+.3g} at {pb.machin:.5g}) and Newton "
                    f"finds no steady state beyond; M_c = M_fold extrapolated by the square-root law")
-    if omega_si is not None and machin_si:
-        res.omega_c = abs(omega_si) * res.machin_c / machin_si
-        res.frequency_c = res.omega_c / (2 * math.pi)
     return True
 
 
-def _done(res, t0):
-    import time
-
-    res.wall_time = time.perf_counter() - t0
-    return res
+#: the default top of the continuation, in units of the paper's scaling line 0.06 (R/L)^-3
+M_MAX_LINES = 20.0
 
 
-def critical_from_config(config, direction: str = "cw", **kw) -> StabilityResult:
+def resolve_m_max(config, m_start: float, m_max: float | None) -> float:
+    """``m_max``, or :data:`M_MAX_LINES` x the config's scaling line; refused (one line) unless
+    above ``m_start``."""
+    from flagwrap.errors import UserInputError
+
+    m = M_MAX_LINES * config.machin_critical_scaling if m_max is None else float(m_max)
+    if not m > m_start:
+        raise UserInputError(f"--m-max (m_max) must be above --m-start ({m_start:g}), got "
+                             f"{m:g}" + ("" if m_max is not None else
+                                         f" (the default, {M_MAX_LINES:g}x the scaling line)"))
+    return m
+
+
+def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m_max=None,
+                         **kw) -> StabilityResult:
     """:func:`find_critical` for a config: its system, turning at the reference speed in
-    ``direction`` ("cw" or "ccw")."""
+    ``direction`` ("cw" or "ccw"), from ``m_start`` to ``m_max`` (:func:`resolve_m_max`).
+    Refuses a bad range or a system the turning frame does not fit before any work."""
     from flagwrap.system.rod_system import RodSystem
     from flagwrap.system.rotating import RotatingFrame
 
-    system = RodSystem(config)
-    frame = RotatingFrame(system, DIRECTIONS[direction])
-    return find_critical(frame, omega_si=config.omega, machin_si=config.machin, **kw)
+    m_max = resolve_m_max(config, m_start, m_max)
+    frame = RotatingFrame(RodSystem(config), DIRECTIONS[direction])
+    return find_critical(frame, m_start=m_start, m_max=m_max, omega_si=config.omega,
+                         machin_si=config.machin, **kw)

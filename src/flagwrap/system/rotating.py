@@ -35,6 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from flagwrap.errors import UserInputError
+from flagwrap.system.rod_system import RodSystem
 
 
 def cross_matrix(a) -> np.ndarray:
@@ -227,29 +228,15 @@ class RotatingSystem:
         f[s.i_phi] = omega
         return f
 
-    def rhs(self, y, base, omega):
-        info = self.forces(y, base)
-        return self.velocity(y, info, omega), info
-
     def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
         r, c, v = self.inner.force_jacobian_coo(self._at_zero(y), base, G0, delta, nonlocal_terms)
         keep = c != self.inner.i_phi
         return r[keep], c[keep], v[keep]
 
-    def force_jacobian(self, y, base, G0=None, delta=None):
-        from flagwrap.system import kernels as SK
-
-        rows, cols, vals = self.force_jacobian_coo(y, base, G0, delta)
-        J = np.zeros((self.inner.ny, self.inner.ny))
-        SK.scatter_dense(rows, cols, vals, J)
-        return J
-
-    def force_jacobian_sparse(self, y, base, G0=None, delta=None):
-        import scipy.sparse as sp
-
-        rows, cols, vals = self.force_jacobian_coo(y, base, G0, delta)
-        n = self.inner.ny
-        return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    # the lab system's own assembly, over this frame's forces, velocity and triplets
+    rhs = RodSystem.rhs
+    force_jacobian = RodSystem.force_jacobian
+    force_jacobian_sparse = RodSystem.force_jacobian_sparse
 
     def interaction_jacobian_coo(self, y, which: str = "all"):
         return self.inner.interaction_jacobian_coo(self._at_zero(y), which)
