@@ -88,7 +88,8 @@ def bench_fig5(workers=2):
     fit = res["fit"]
     print(f"Fig. 5 boundary by the stability tool: {len(found)} of {len(res['rows'])} helices "
           f"with a crossing, {res['wall_time_s']:.1f} s on {workers} processes; fit "
-          f"M_c = {fit.get('prefactor', float('nan')):.3g} (R/L)^-{fit.get('exponent', float('nan')):.2f}")
+          f"M_c = {fit.get('prefactor') or float('nan'):.3g} "
+          f"(R/L)^-{fit.get('exponent') or float('nan'):.2f}")
 
 
 def main():

@@ -232,9 +232,9 @@ def _run_sweep(args) -> int:
             for row in res["rows"]:
                 print(_row_line(row))
         fit = res["fit"]
-        if "prefactor" in fit:
+        if fit.get("exponent") is not None:
             print(f"fit over {fit['n']} helices: M_c = {fit['prefactor']:.3g} (R/L)^-"
-                  f"{fit['exponent']:.3f} +- {fit['exponent_se']:.3f} (rms {fit['rms_ln']:.2f} in "
+                  f"{fit['exponent']:.3f} +- {fit['exponent_err']:.3f} (rms {fit['rms_ln']:.2f} in "
                   f"ln M_c); the paper's line: 0.06 (R/L)^-3")
         print(f"{len(res['rows'])} helices, {res['wall_time_s']:.1f} s on {res['workers']} "
               f"processes; wrote {out}")

@@ -220,10 +220,11 @@ def draw_stability(ax, stab):
                    facecolors=cmap(norm(r["psi_deg"])), edgecolors="tab:red", linewidths=1.2,
                    label="linear M_c (flagwrap stability)" if i == 0 else None)
     fit = stab.get("fit") or {}
-    if pts and math.isfinite(fit.get("exponent", math.nan)):
+    be = fit.get("exponent")  # None (JSON's NaN) when there was nothing to fit
+    if pts and be is not None and math.isfinite(be):
         xs = np.array([r["r_over_l"] ** 3 for r in pts])
         xline = np.logspace(np.log10(xs.min()) - 0.1, np.log10(xs.max()) + 0.1, 30)
-        c, be = fit["prefactor"], fit["exponent"]
+        c = fit["prefactor"]
         ax.plot(xline, c * xline ** (-be / 3), "-.", color="tab:red", lw=1.2,
                 label=rf"linear: $M_c = {c:.3g}\,(R/L)^{{-{be:.2f}}}$")
 

@@ -55,24 +55,24 @@ def helix_threshold(item, m_factor: float = 30.0, rtol: float = 1e-3) -> dict:
 
 
 def fit_power_law(rows) -> dict:
-    """Least-squares ``ln M_c = ln c - beta ln (R/L)`` over the rows with a crossing:
-    ``prefactor`` c, ``exponent`` beta, their standard errors, ``n``; the paper's line is
-    c = 0.06, beta = 3."""
+    """``ln M_c = ln c - beta ln (R/L)`` over the rows with a crossing, by the diagram's own
+    fit (:func:`flagwrap.plotting.diagram.fit_boundary`). The linear thresholds are sharp
+    (rtol 1e-3), so every point gets its floor weight and the fit is plain least squares, with
+    errors from the scatter. ``rms_ln`` is that scatter; the paper's line is c = 0.06,
+    beta = 3."""
     import numpy as np
 
-    pts = [(r["r_over_l"], r["machin_c"]) for r in rows if r.get("machin_c")]
-    if len(pts) < 3:
-        return {"n": len(pts)}
-    x = np.log([p[0] for p in pts])
-    y = np.log([p[1] for p in pts])
-    A = np.vstack([np.ones_like(x), -x]).T
-    coef, res, *_ = np.linalg.lstsq(A, y, rcond=None)
-    dof = max(1, len(x) - 2)
-    s2 = float(np.sum((y - A @ coef) ** 2)) / dof
-    cov = s2 * np.linalg.inv(A.T @ A)
-    return {"n": len(pts), "prefactor": float(math.exp(coef[0])), "exponent": float(coef[1]),
-            "ln_prefactor_se": float(math.sqrt(cov[0, 0])), "exponent_se": float(math.sqrt(cov[1, 1])),
-            "rms_ln": float(math.sqrt(s2))}
+    from flagwrap.plotting.diagram import fit_boundary
+
+    pts = [{"kind": "bracket", "r_over_l": r["r_over_l"], "machin_c": r["machin_c"],
+            "sigma_ln": 0.0} for r in rows if r.get("machin_c")]
+    fit = fit_boundary(pts)
+    if math.isfinite(fit["exponent"]):
+        x = np.log([p["r_over_l"] for p in pts])
+        y = np.log([p["machin_c"] for p in pts])
+        resid = y - (math.log(fit["prefactor"]) - fit["exponent"] * x)
+        fit["rms_ln"] = float(math.sqrt(np.sum(resid**2) / max(1, len(pts) - 2)))
+    return fit
 
 
 def stability_boundary(spec, workers: int | None = None, on_row=None, **kw) -> dict:
