@@ -78,8 +78,6 @@ def check_rotating_frame(system) -> None:
                 f"the rotating frame needs every interaction to be invariant under rotations "
                 f"about the motor axis; {getattr(it, 'name', type(it).__name__)!r} does not say "
                 f"it is (set rotation_invariant = True on it if it is)")
-    if getattr(system.body, "pose", None) is not None:
-        raise UserInputError("the rotating frame needs a fixed, axisymmetric cell body")
 
 
 class RotatingFrame:
