@@ -134,7 +134,8 @@ class FixedBodyMobility:
     ``(M_ff - M_fb M_bb^-1 M_bf) F``. That Schur complement is the mobility here. ``M_bb`` is
     factorised once, since the body does not move. It is symmetric and positive definite, and
     smaller than ``M_ff``: the surface screens the flow. Viscosity 1; the bead radius is one
-    number, the blobs' radii per blob.
+    number, the blobs' radii per blob. It has ``matrix`` and ``apply`` of the mobility
+    interface; the banded solvers' ``near_field_blocks`` come when a system uses it.
     """
 
     long_range = True
@@ -181,19 +182,3 @@ class FixedBodyMobility:
         C = self._cross(x)
         lam = sl.cho_solve(self._chol, C.T @ F.ravel(), check_finite=False)
         return self._free.apply(x, F) - (C @ lam).reshape(-1, 3)
-
-    def apply_single(self, x, F):
-        return self.apply(x, F)
-
-    def near_field_blocks(self, x, width: int):
-        """Bead-bead blocks of the screened mobility along the chain (for banded
-        preconditioners), from the dense matrix."""
-        n = len(x)
-        M = self.matrix(x)
-        out = np.zeros((n, 2 * width + 1, 3, 3))
-        for i in range(n):
-            for k in range(-width, width + 1):
-                j = i + k
-                if 0 <= j < n:
-                    out[i, width + k] = M[3 * i:3 * i + 3, 3 * j:3 * j + 3]
-        return out
