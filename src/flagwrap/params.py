@@ -31,6 +31,9 @@ MAX_BOND_OVER_RADIUS = 100.0
 #: the cell body is wider than the filament and not absurdly larger than it:
 #: 2 a < R_cell <= 10 L
 MAX_BODY_OVER_LENGTH = 10.0
+#: most blobs on a no-slip body for the direct (dense Cholesky) solve: 4000 blobs are a
+#: 12000^2 matrix, 1.15 GB, factorised once in ~10 s on one core
+MAX_BLOBS = 4000
 
 
 def _finite(name: str, value) -> float:
@@ -277,14 +280,32 @@ class CellBody:
     ``cylinder_length`` [m] defaults to ``5 R_cell`` (the experiment's 25 cm cylinder of 5 cm
     radius). The fluid passes through the body (paper, Methods); only a
     short-ranged repulsion keeps beads outside. ``enabled = false`` removes it altogether.
+
+    ``surface``: ``"transparent"`` (default, the paper's rig: the fluid passes through the
+    body) or ``"no-slip"`` (the rigid multiblob method, :mod:`flagwrap.body.multiblob`: blobs
+    of radius ``blob_radius`` about ``blob_spacing`` apart on the surface hold the fluid back;
+    needs ``numerics.hydrodynamics = true``). ``motion``: ``"fixed"`` (default, the rig) or
+    ``"free"`` (force- and torque-free, a swimming cell: :mod:`flagwrap.system.swimmer`; needs
+    a no-slip surface, since a transparent body has no drag, and a motor that turns).
+    ``blob_spacing`` [m] defaults to ``R_cell / 3`` and ``blob_radius`` [m] to half the
+    spacing (Usabiaga et al. 2016 use blobs about half their spacing; docs/bacterium.md
+    measures the convergence in both).
     """
 
     radius: float | None = None
     radius_ratio: float | None = None  # 0.6 when radius is not given either
     cylinder_length: float | None = None
     enabled: bool = True
+    surface: str = "transparent"
+    motion: str = "fixed"
+    blob_spacing: float | None = None
+    blob_radius: float | None = None
 
     DEFAULT_RADIUS_RATIO = 0.6
+    SURFACES = ("transparent", "no-slip")
+    MOTIONS = ("fixed", "free")
+    #: keys added after results were stored, left out of result keys at these defaults
+    HASH_OMIT_DEFAULTS = {"surface": "transparent", "motion": "fixed"}
 
     def __post_init__(self):
         if self.radius is not None:
@@ -304,6 +325,38 @@ class CellBody:
             _positive("body.cylinder_length", self.cylinder_length, "m")
         if not isinstance(self.enabled, bool):
             raise UserInputError(f"body.enabled must be true or false, got {self.enabled!r}")
+        if self.surface not in self.SURFACES:
+            raise UserInputError(f"body.surface must be one of {', '.join(self.SURFACES)}, "
+                                 f"got {self.surface!r}")
+        if self.motion not in self.MOTIONS:
+            raise UserInputError(f"body.motion must be one of {', '.join(self.MOTIONS)}, "
+                                 f"got {self.motion!r}")
+        for key in ("blob_spacing", "blob_radius"):
+            if getattr(self, key) is not None:
+                _positive(f"body.{key}", getattr(self, key), "m")
+        if self.surface == "no-slip" and not self.enabled:
+            raise UserInputError("body.surface = 'no-slip' needs body.enabled = true")
+        if self.motion == "free" and self.surface != "no-slip":
+            raise UserInputError("body.motion = 'free' needs body.surface = 'no-slip': a "
+                                 "transparent body has no drag, so nothing would set its motion")
+
+    @property
+    def no_slip(self) -> bool:
+        return self.enabled and self.surface == "no-slip"
+
+    @property
+    def free(self) -> bool:
+        return self.enabled and self.motion == "free"
+
+    def resolved_blob_spacing(self, helix_radius: float) -> float:
+        if self.blob_spacing is not None:
+            return self.blob_spacing
+        return self.resolved_radius(helix_radius) / 3.0
+
+    def resolved_blob_radius(self, helix_radius: float) -> float:
+        if self.blob_radius is not None:
+            return self.blob_radius
+        return 0.5 * self.resolved_blob_spacing(helix_radius)
 
     def resolved_radius(self, helix_radius: float) -> float:
         return self.radius if self.radius is not None else helix_radius / self.radius_ratio
@@ -718,6 +771,8 @@ class Config:
                     f"{how} gives a cell body of radius {rc:.3g} m; it must be wider than the "
                     f"filament (> 2 a = {2 * a:.3g} m) and at most {MAX_BODY_OVER_LENGTH:g} L = "
                     f"{MAX_BODY_OVER_LENGTH * fil.length:.3g} m (or set body.enabled = false)")
+        if self.body.no_slip or self.body.free:
+            self._check_surface_body()
         # beads that are not contour neighbours must not overlap in the stress-free helix
         from flagwrap.geometry.helix import min_nonlocal_distance
 
@@ -753,6 +808,39 @@ class Config:
                     f"({', '.join(f'{k} = {x:g}' for k, x in derived.items())}): the inputs "
                     "(filament.youngs_modulus, cross_section_radius, length, fluid.viscosity, "
                     "motor.machin/frequency) are out of physical range")
+
+    def _check_surface_body(self):
+        """A no-slip or free body: its blob surface, the hydrodynamics it needs, the motor."""
+        from flagwrap.body.multiblob import cell_body_blobs, check_spacing
+
+        b, R = self.body, self.filament.helix_radius
+        if not self.numerics.hydrodynamics:
+            raise UserInputError("body.surface = 'no-slip' needs numerics.hydrodynamics = true "
+                                 "(without hydrodynamic interactions a surface screens nothing)")
+        rc, sp = b.resolved_radius(R), b.resolved_blob_spacing(R)
+        if not sp < rc:
+            raise UserInputError(f"body.blob_spacing = {sp:g} m must be smaller than the body "
+                                 f"radius {rc:g} m")
+        blobs, _ = cell_body_blobs(self)
+        if len(blobs) > MAX_BLOBS:
+            raise UserInputError(
+                f"body.blob_spacing = {sp:g} m puts {len(blobs)} blobs on the body, more than "
+                f"{MAX_BLOBS} (the direct solve's limit); use a spacing >= "
+                f"{sp * math.sqrt(len(blobs) / MAX_BLOBS):.3g} m")
+        check_spacing(blobs * self.filament.length, b.resolved_blob_radius(R),
+                      what="body.blob_radius [m]")
+        if self.numerics.frame != "lab":
+            raise UserInputError("numerics.frame = 'rotating' needs a body symmetric about the "
+                                 "motor axis; a blob surface is not: use numerics.frame = 'lab'")
+        if b.free:
+            if all(p.direction == "stop" for p in self.motor.protocol):
+                raise UserInputError("body.motion = 'free' needs a motor that turns: every phase "
+                                     "of motor.protocol is 'stop'")
+            if self.filament.density is not None and self.filament.density != self.fluid.density:
+                raise UserInputError(
+                    "body.motion = 'free' with a filament of density "
+                    f"{self.filament.density:g} kg/m^3 != fluid.density {self.fluid.density:g}: "
+                    "gravity on a swimming cell is not modelled yet; give no filament.density")
 
     # derived dimensionless numbers -------------------------------------------------------------
     @property
@@ -850,4 +938,7 @@ class Config:
             for k, v in Numerics.HASH_OMIT_DEFAULTS.items():
                 if d["numerics"].get(k) == v:
                     d["numerics"].pop(k)
+            for k, v in CellBody.HASH_OMIT_DEFAULTS.items():
+                if d["body"].get(k) == v:
+                    d["body"].pop(k)
         return d

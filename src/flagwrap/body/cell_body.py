@@ -70,3 +70,16 @@ class NoBody:
 
     def distance(self, x):
         return np.full(len(x), np.inf)
+
+
+def body_mobility(config, radius: float):
+    """The beads' mobility beside ``config``'s fixed no-slip body
+    (:class:`~flagwrap.hydrodynamics.polydisperse.FixedBodyMobility`, bead ``radius`` in core
+    units), or ``None`` for a transparent body (the free-space mobility applies)."""
+    if not config.body.no_slip:
+        return None
+    from flagwrap.body.multiblob import cell_body_blobs
+    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+
+    blobs, radii = cell_body_blobs(config)
+    return FixedBodyMobility(radius, blobs, radii)

@@ -205,3 +205,14 @@ def stimson_jeffery(separation_over_radius: float, terms: int = 200000) -> float
         if abs(term) < 1e-16 * abs(s):
             break
     return 4.0 / 3.0 * math.sinh(al) * s
+
+
+def cell_body_blobs(config) -> tuple[np.ndarray, np.ndarray]:
+    """The blobs of ``config``'s no-slip cell body in core units (lengths in ``L``): centres
+    (n, 3) on the capped cylinder of :class:`~flagwrap.body.cell_body.CappedCylinder` (lowest
+    point at the origin) and their radii (n,)."""
+    b, fil = config.body, config.filament
+    R, L = fil.helix_radius, fil.length
+    blobs = capped_cylinder_blobs(b.resolved_radius(R) / L, b.resolved_length(R) / L,
+                                  b.resolved_blob_spacing(R) / L)
+    return blobs, np.full(len(blobs), b.resolved_blob_radius(R) / L)

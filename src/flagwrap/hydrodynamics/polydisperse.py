@@ -135,11 +135,15 @@ class FixedBodyMobility:
     factorised once, since the body does not move. It is symmetric and positive definite, and
     smaller than ``M_ff``: the surface screens the flow. Viscosity 1; the bead radius is one
     number, the blobs' radii per blob. It has ``matrix`` and ``apply`` of the mobility
-    interface; the banded solvers' ``near_field_blocks`` come when a system uses it.
+    interface. ``apply_single`` is ``apply``, and ``near_field_blocks`` (for the banded
+    preconditioner of the Krylov stage solver) are the free beads': a preconditioner may be
+    approximate. Not symmetric about the motor axis (``axisymmetric = False``): the blob shell
+    is not, so the turning frame refuses it.
     """
 
     long_range = True
     backend = "direct+fixed-body"
+    axisymmetric = False
 
     def __init__(self, radius: float, blobs, blob_radii):
         import scipy.linalg as sl
@@ -175,6 +179,9 @@ class FixedBodyMobility:
         M -= self.screening(x)
         return M
 
+    def near_field_blocks(self, x, width: int):
+        return self._free.near_field_blocks(x, width)
+
     def apply(self, x, F):
         import scipy.linalg as sl
 
@@ -182,3 +189,5 @@ class FixedBodyMobility:
         C = self._cross(x)
         lam = sl.cho_solve(self._chol, C.T @ F.ravel(), check_finite=False)
         return self._free.apply(x, F) - (C @ lam).reshape(-1, 3)
+
+    apply_single = apply

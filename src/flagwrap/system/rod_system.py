@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flagwrap.system import kernels as SK
-from flagwrap.body.cell_body import CappedCylinder, NoBody
+from flagwrap.body.cell_body import CappedCylinder, NoBody, body_mobility
 from flagwrap.elasticity.rod import Frames, RestState, initial_frames, rest_state
 from flagwrap.geometry.helix import filament_positions
 from flagwrap.hydrodynamics.mobility import make_mobility
@@ -103,7 +103,7 @@ class RodSystem:
         # hydrodynamics (radius in core units)
         self.radius = fil.bead_radius / L
         num = config.numerics
-        self.mobility = mobility or make_mobility(
+        self.mobility = mobility or body_mobility(config, self.radius) or make_mobility(
             num.hydrodynamics, self.radius, backend=num.mobility_backend,
             n=N, threads=num.threads, fmm_eps=num.mobility_tol)
         w = np.ones(N - 1)
@@ -156,11 +156,28 @@ class RodSystem:
         (the clamp's beads are not free unknowns, so they stay where the clamp holds them)."""
         ini = self.config.initial
         if ini.perturbation == 0.0:
+            self._check_outside_body(self.x0)
             return self.pack(self.x0, self.theta0, 0.0)
         from flagwrap.geometry.perturbation import displacement
 
         dx = displacement(self.N, ini.perturbation / self.config.filament.length, ini.mode, ini.seed)
+        dx[:self.nc] = 0.0  # the clamp's beads are where the clamp holds them
+        self._check_outside_body(self.x0 + dx)
         return self.pack(self.x0 + dx, self.theta0, 0.0)
+
+    def _check_outside_body(self, x) -> None:
+        """Refuse a start with a free bead's centre inside the cell body (one line, exit 2)."""
+        d = self.body.distance(x[self.nc:])
+        if d.size and d.min() <= 0.0:
+            from flagwrap.errors import UserInputError
+
+            i = int(np.argmin(d))
+            L = self.config.filament.length
+            raise UserInputError(
+                f"body overlaps the filament at the start: bead {i + self.nc} is "
+                f"{-d[i] * L:.3g} m inside the cell body (initial.perturbation = "
+                f"{self.config.initial.perturbation:g} m, filament.n_beads = {self.config.filament.n_beads}); "
+                "use a smaller initial.perturbation, another initial.seed, or more beads")
 
     def pack(self, x, theta, phi) -> np.ndarray:
         y = np.empty(self.ny)

@@ -72,6 +72,10 @@ def check_rotating_frame(system) -> None:
     g = np.asarray(system.gravity)
     if np.any(np.abs(g[:, :2]) > 0.0):
         raise UserInputError("the rotating frame needs gravity along the motor axis")
+    if not getattr(system.mobility, "axisymmetric", True):
+        raise UserInputError(
+            f"the rotating frame needs a mobility symmetric about the motor axis; "
+            f"{type(system.mobility).__name__} (a no-slip blob body) is not: use the lab frame")
     for it in system.interactions:
         if not getattr(it, "rotation_invariant", False):
             raise UserInputError(
