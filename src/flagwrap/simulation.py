@@ -61,6 +61,9 @@ class Trajectory:
     hook_angle: list = field(default_factory=list)
     hook_torque: list = field(default_factory=list)
     hook_twist_torque: list = field(default_factory=list)
+    #: a free body's [X (3), q (4), U (3), Omega (3)] per frame (lab frame, core units);
+    #: empty for a fixed body
+    body: list = field(default_factory=list)
     status: str = "running"
     message: str = ""
     n_steps: int = 0
@@ -73,7 +76,10 @@ class Trajectory:
         return self.status == "completed"
 
     def arrays(self) -> dict:
-        return {k: np.asarray(getattr(self, k)) for k in _RECORDS}
+        out = {k: np.asarray(getattr(self, k)) for k in _RECORDS}
+        if self.body:
+            out["body"] = np.asarray(self.body)
+        return out
 
 
 class Simulation:
@@ -105,6 +111,7 @@ class Simulation:
 
     def _record(self, traj, t, y, info, omega):
         s = self.system
+        info_in = info
         info = s.record_view(y, info)  # the lab frame (a turning-frame system rotates it back)
         m1 = np.empty((s.N - 1, 3))
         m2 = np.empty((s.N - 1, 3))
@@ -119,8 +126,12 @@ class Simulation:
                s.motor_torque(info, phi, omega), info.elastic_energy, info.contact_energy,
                float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf,
                self._strain(info), info.interaction_energy) + hook
+        body = getattr(s, "body_record", None)  # a moving body's pose and velocities
+        body = None if body is None else body(y, info_in)
         for name, value in zip(_RECORDS, row):
             getattr(traj, name).append(value)
+        if body is not None:
+            traj.body.append(body)
 
     def _strain(self, info) -> float:
         ln = np.linalg.norm(np.diff(info.x, axis=0), axis=1)
@@ -444,6 +455,10 @@ class RunInterrupted(KeyboardInterrupt):
 def make_system(config):
     """The config's system: a :class:`RodSystem`, stepped in the turning frame when
     ``numerics.frame = "rotating"`` (:class:`flagwrap.system.rotating.RotatingSystem`)."""
+    if config.body.free:
+        from flagwrap.system.swimmer import make_swimmer
+
+        return make_swimmer(config)
     system = RodSystem(config)
     if config.numerics.frame == "rotating":
         from flagwrap.system.rotating import RotatingSystem

@@ -333,7 +333,11 @@ class SparseW:
 
 def make_w(kind, system, y, base, G0, gamma_h, err_scale=None):
     """The stage solver ``kind`` for ``W = I - gamma_h Mob J`` at ``y``; ``err_scale``: the
-    absolute accuracy each unknown of a solution needs (iterative solvers stop on it)."""
+    absolute accuracy each unknown of a solution needs (iterative solvers stop on it).
+    A system with its own stage solver (``system.make_w``, e.g. the free swimmer's) gets it."""
+    own = getattr(system, "make_w", None)
+    if own is not None:
+        return own(kind, y, base, G0, gamma_h, err_scale)
     if kind == "auto":
         if not system.mobility.long_range:
             kind = "banded"

@@ -24,7 +24,14 @@ hook_angle             (time)                 angle between the motor's bond and
                                               bond of the filament proper [rad]
 hook_torque            (time)                 bending torque at the joint's vertex [N m]
 hook_twist_torque      (time)                 twist torque at the joint's vertex [N m]
+body_position          (time, xyz)            a free body's reference point (the pole) [m]
+body_orientation       (time, quat)           its unit quaternion (w, x, y, z), body -> lab
+body_velocity          (time, xyz)            its velocity [m/s]
+body_angular_velocity  (time, xyz)            its angular velocity [rad/s]
 =====================  =====================  ==============================================
+
+The four ``body_*`` variables are written for a free body (``body.motion = "free"``) only;
+a fixed body sits at the origin with the identity orientation.
 
 Global attributes: ``flagwrap_version``, ``format_version``, ``config_toml`` (the full input,
 re-loadable), ``status`` ("completed" or "failed"), ``message``, ``machin`` (M), ``reynolds``,
@@ -114,6 +121,14 @@ def trajectory_dataset(traj):
                            "rotation sign: positive = CCW seen from the free end",
         },
     )
+    if "body" in a:  # a free body's pose and velocities (core -> SI)
+        b = a["body"]
+        ds["body_position"] = (("time", "xyz"), b[:, :3] * L, {"units": "m"})
+        ds["body_orientation"] = (("time", "quat"), b[:, 3:7],
+                                  {"units": "1", "long_name": "unit quaternion (w, x, y, z), body to lab"})
+        ds["body_velocity"] = (("time", "xyz"), b[:, 7:10] * L * sc.omega, {"units": "m/s"})
+        ds["body_angular_velocity"] = (("time", "xyz"), b[:, 10:13] * sc.omega, {"units": "rad/s"})
+        ds.coords["quat"] = ["w", "x", "y", "z"]
     return ds
 
 

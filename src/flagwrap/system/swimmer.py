@@ -1,0 +1,281 @@
+"""A free-swimming cell: a force- and torque-free no-slip body, its motor and its filament.
+
+The equations are stepped in the frame of the body (``body.motion = "free"``). There the
+body's blobs stand still, so their RPY matrix ``M_bb`` and its Cholesky factor are computed
+once, and the motor's joint is the fixed rig's, turning at the motor's rate *relative to the
+body*. The body moves with velocity ``U`` and angular velocity ``Omega`` (body axes, about
+the body's reference point, the pole where the motor sits), and a point at ``x'`` in body
+coordinates moves in the body frame at its lab velocity less the rigid motion:
+
+    dx'/dt = v' - U - Omega x x',        dtheta'/dt = tau / zeta - Omega . t'
+
+(the twist term as in :mod:`flagwrap.system.rotating`: a rigid rotation turns the material
+frame about ``t`` at ``Omega . t`` against the transported reference frame).
+
+**The mobility problem** (rigid multiblob, Usabiaga et al. 2016, Sec. 3, with the filament's
+beads as free particles): bead forces ``F`` and twist torques ``tau`` are the generalized
+forces ``G = -dU/dy`` of the free unknowns. The body (the cell, the rotor and the motor's
+clamped beads, one rigid object with a motor inside) carries the load ``-S G``: the energy is
+invariant under a rigid motion of everything, so what the free beads and bonds feel, the body
+feels with the opposite sign (``S G = [sum F; sum x' x F + sum tau t]``). The blobs' forces
+``lambda`` hold the surface to the rigid motion ``K V``, ``V = [U; Omega]``::
+
+    M_bb lambda + M_bf F = K V,     K^T lambda = -S G      (force and torque balance)
+
+so with ``E = K^T M_bb^-1 M_bf`` (6 x 3n) and ``N = (K^T M_bb^-1 K)^-1`` (the body's
+mobility) ``V = N (E - S) G`` and the beads move at ``v' = (M_ff - M_fb M_bb^-1 M_bf) F +
+E^T V``. The whole map ``G -> dy/dt`` is ``A G`` with
+
+    A = A_fixed + (E - S)^T N (E - S),
+
+``A_fixed`` the fixed no-slip body's mobility (:class:`~flagwrap.hydrodynamics.polydisperse.
+FixedBodyMobility`) and the rank-6 term the body's motion: symmetric, positive
+semidefinite, and the total force and torque on the fluid vanish (``K^T lambda + S G = 0``).
+The twist torques act on the fluid locally (the bond's rotational drag), as in the rig.
+
+The body's pose (lab position ``X`` of its reference point and unit quaternion ``q``, body to
+lab) is carried in ``y`` after the filament's unknowns: ``dX/dt = R(q) U``, ``dq/dt =
+q (0, Omega) / 2``. Nothing depends on the pose (no gravity on a free cell), so the stage
+solver ``W`` is the filament's ``I - gamma h A J`` with the identity on the pose: a W-method
+keeps its order for such a ``W``. Run files are written in the lab frame (:meth:`record_view`)
+and carry the body's pose and velocities (:meth:`body_record`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from flagwrap.system.layout import DofLayout
+
+
+def quaternion_matrix(q) -> np.ndarray:
+    """Rotation matrix of the quaternion ``q = (w, x, y, z)`` (normalised here)."""
+    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def quaternion_rate(q, omega_body) -> np.ndarray:
+    """``dq/dt = q (0, Omega) / 2`` for the body-frame angular velocity ``Omega``."""
+    w, x, y, z = q
+    a, b, c = omega_body
+    return 0.5 * np.array([-x * a - y * b - z * c, w * a + y * c - z * b,
+                           w * b + z * a - x * c, w * c + x * b - y * a])
+
+
+class SwimmerSystem:
+    """A :class:`~flagwrap.system.rod_system.RodSystem` (in the body frame, free-space bead
+    mobility) with a force- and torque-free no-slip body (module docstring).
+
+    ``system``: the filament's system; ``blobs``, ``blob_radii``: the body's surface in body
+    coordinates (core units). Everything not overridden here is the filament system's.
+    """
+
+    def __init__(self, system, blobs, blob_radii):
+        from flagwrap.body.multiblob import geometric_matrix
+        from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY
+
+        if not system.mobility.long_range or getattr(system.mobility, "backend", "") != "direct":
+            raise ValueError("SwimmerSystem needs the filament's free-space direct RPY mobility")
+        if np.any(system.gravity):
+            raise ValueError("SwimmerSystem: gravity on a free cell is not modelled")
+        self.inner = system
+        self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
+        self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
+                                               dtype=np.float64)
+        Mbb = PolydisperseRPY(self.blob_radii).matrix(self.blobs)
+        self._chol = sla.cho_factor(Mbb, lower=True, check_finite=False)
+        self.K = geometric_matrix(self.blobs)
+        self._MinvK = sla.cho_solve(self._chol, self.K, check_finite=False)  # (3 n_blob, 6)
+        #: the body's own mobility (K^T M_bb^-1 K)^-1, viscosity 1, about the reference point
+        self.body_mobility = np.linalg.inv(0.5 * (self.K.T @ self._MinvK + (self.K.T @ self._MinvK).T))
+        s = system
+        self.n_in = s.ny
+        self.layout = DofLayout([(b.name, b.kind, b.size) for b in s.layout.blocks]
+                                + [("body_x", "position", 3), ("body_q", "angle", 4)])
+        self.ny = self.layout.size
+        self.sl_X = self.layout["body_x"]
+        self.sl_q = self.layout["body_q"]
+        self._cross = np.empty((3 * s.nb, 3 * len(self.blobs)))
+
+    def __getattr__(self, name):  # everything not overridden is the filament system's
+        return getattr(self.inner, name)
+
+    # state ---------------------------------------------------------------------------------
+    def initial_y(self) -> np.ndarray:
+        return np.concatenate([self.inner.initial_y(), np.zeros(3), [1.0, 0.0, 0.0, 0.0]])
+
+    def unpack(self, y):
+        return self.inner.unpack(y[:self.n_in])
+
+    def pose(self, y) -> tuple[np.ndarray, np.ndarray]:
+        """``(X, R)``: the body's reference point in the lab and its rotation (body -> lab)."""
+        return np.array(y[self.sl_X]), quaternion_matrix(y[self.sl_q])
+
+    # forces: the filament's, in the body frame (nothing depends on the pose) ----------------
+    def forces(self, y, base):
+        return self.inner.forces(y[:self.n_in], base)
+
+    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
+        return self.inner.force_jacobian_coo(y[:self.n_in], base, None if G0 is None else
+                                             G0[:self.n_in], delta, nonlocal_terms)
+
+    def interaction_jacobian_coo(self, y, which: str = "all"):
+        return self.inner.interaction_jacobian_coo(y[:self.n_in], which)
+
+    # mobility ------------------------------------------------------------------------------
+    def _geometry(self, y):
+        """Free beads' body-frame positions (nb, 3), free bonds' tangents (ne, 3), ``M_fb``."""
+        s = self.inner
+        from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
+
+        x, _, _ = s.unpack(y[:self.n_in])
+        xf = np.ascontiguousarray(x[s.nc:])
+        e = x[s.ec + 1:] - x[s.ec:-1]
+        t = e / np.linalg.norm(e, axis=1)[:, None]
+        rpy_cross_radii(xf, s.radius, self.blobs, self.blob_radii, self._cross)
+        return xf, t, self._cross
+
+    def _load(self, xf, t, F, tau) -> np.ndarray:
+        """``S G = [sum F; sum x x F + sum tau t]`` (6,)."""
+        return np.concatenate([F.sum(axis=0), np.cross(xf, F).sum(axis=0) + tau @ t])
+
+    def body_velocity(self, y, G) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(V, v_beads, lambda)``: the body's ``[U; Omega]`` (body axes, core units), the free
+        beads' lab-frame velocities in body axes, and the blob forces (core units) for the
+        generalized forces ``G`` (filament unknowns) at ``y``."""
+        s = self.inner
+        xf, t, C = self._geometry(y)
+        F = np.asarray(G[s.sl_x]).reshape(-1, 3)
+        tau = np.asarray(G[s.sl_th])
+        w = sla.cho_solve(self._chol, C.T @ F.ravel(), check_finite=False)
+        V = self.body_mobility @ (self.K.T @ w - self._load(xf, t, F, tau))
+        lam = self._MinvK @ V - w
+        v = s.mobility.apply(xf, F) + (C @ lam).reshape(-1, 3)
+        return V / s.machin, v / s.machin, lam
+
+    def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
+        """``A G`` (module docstring) over the whole state: filament rows in the body frame,
+        pose rows ``dX/dt = R U``, ``dq/dt = q (0, Omega) / 2``; the motor angle's row 0."""
+        s = self.inner
+        V, v, _ = self.body_velocity(y, G)
+        U, Om = V[:3], V[3:]
+        xf, t, _ = self._geometry(y)
+        out = np.zeros(self.ny)
+        out[s.sl_x] = (v - U - np.cross(Om, xf)).ravel()
+        out[s.sl_th] = s.twist_mobility * G[s.sl_th] - t @ Om
+        q = y[self.sl_q] / np.linalg.norm(y[self.sl_q])
+        out[self.sl_X] = quaternion_matrix(q) @ U
+        out[self.sl_q] = quaternion_rate(q, Om)
+        return out
+
+    def velocity(self, y, info, omega: float) -> np.ndarray:
+        f = self.apply_mobility(y, info.G)
+        f[self.inner.i_phi] = omega
+        return f
+
+    def rhs(self, y, base, omega):
+        info = self.forces(y, base)
+        return self.velocity(y, info, omega), info
+
+    def mobility_matrix(self, y, screening: bool = True) -> np.ndarray:
+        """Dense ``A`` over the filament's unknowns (n_in, n_in; motor-angle row and column 0):
+        ``A_fixed + D^T N D``, ``D = E - S``.
+
+        ``screening=False``: without the fixed surface's screening ``M_fb M_bb^-1 M_bf`` (the
+        stage solver's ``W``: that term costs a triangular solve with every bead as right-hand
+        side, ~90 % of a step, and is smooth, so the stiff local modes hardly see it)."""
+        s = self.inner
+        xf, t, C = self._geometry(y)
+        n3 = 3 * s.nb
+        A = np.zeros((self.n_in, self.n_in))
+        A[:n3, :n3] = s.mobility.matrix(xf)
+        if screening:
+            Y = sla.solve_triangular(self._chol[0], C.T, lower=True, check_finite=False)
+            A[:n3, :n3] -= Y.T @ Y
+        idx = np.arange(n3, n3 + s.ne)
+        A[idx, idx] = s.twist_mobility * s.machin
+        D = np.zeros((6, self.n_in))
+        D[:, :n3] = (C @ self._MinvK).T
+        # - S: [I; [x]_x] per bead, [0; t] per bond
+        D[:3, :n3] -= np.tile(np.eye(3), (1, s.nb))
+        Dx = D[3:, :n3].reshape(3, s.nb, 3)
+        Dx[0, :, 1] += xf[:, 2]
+        Dx[0, :, 2] -= xf[:, 1]
+        Dx[1, :, 0] -= xf[:, 2]
+        Dx[1, :, 2] += xf[:, 0]
+        Dx[2, :, 0] += xf[:, 1]
+        Dx[2, :, 1] -= xf[:, 0]
+        D[3:, n3:n3 + s.ne] -= t.T
+        A += D.T @ self.body_mobility @ D
+        return A / s.machin
+
+    def make_w(self, kind, y, base, G0, gamma_h, err_scale=None):
+        """The stage solver: dense LU of ``I - gamma h A J`` on the filament, identity on the
+        pose (module docstring), with ``A`` less the surface's screening
+        (:meth:`mobility_matrix`); every ``kind`` gets it. Measured (docs/bacterium.md):
+        0.3 turn of the 61-bead Fig. 4(a) swimmer takes 537 steps against 506 with the exact
+        ``A``, at half the time per step; the free-space mobility alone (no body term) 567."""
+        return SwimmerW(self, y, base, G0, gamma_h)
+
+    # output --------------------------------------------------------------------------------
+    def record_view(self, y, info):
+        """``info`` with positions, gradients and reference frames in the lab frame."""
+        import dataclasses
+
+        from flagwrap.elasticity.rod import Frames
+
+        X, R = self.pose(y)
+        fr = info.frames
+        return dataclasses.replace(info, x=info.x @ R.T + X, grad_x=info.grad_x @ R.T,
+                                   frames=Frames(fr.t @ R.T, fr.d1 @ R.T, fr.rt))
+
+    def body_record(self, y, info) -> np.ndarray:
+        """``[X (3), q (4), U (3), Omega (3)]``: the body's lab position and orientation
+        (unit quaternion, body -> lab), and its velocity and angular velocity in lab axes
+        (core units)."""
+        X, R = self.pose(y)
+        V, _, _ = self.body_velocity(y, info.G)
+        q = y[self.sl_q] / np.linalg.norm(y[self.sl_q])
+        return np.concatenate([X, q, R @ V[:3], R @ V[3:]])
+
+
+class SwimmerW:
+    """Dense LU of the swimmer's ``W`` (:meth:`SwimmerSystem.make_w`)."""
+
+    def __init__(self, system, y, base, G0, gamma_h):
+        from flagwrap.integrators.linear import SingularW
+
+        n = system.n_in
+        J = system.inner.force_jacobian(y[:n], base, G0[:n])
+        W = -gamma_h * (system.mobility_matrix(y, screening=False) @ J)
+        W[np.diag_indices(n)] += 1.0
+        self.n = n
+        try:
+            self.lu = sla.lu_factor(W, overwrite_a=True, check_finite=False)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            raise SingularW(str(exc)) from None
+        if not np.all(np.isfinite(self.lu[0])):
+            raise SingularW("non-finite LU")
+
+    def solve(self, rhs):
+        out = np.array(rhs, float)
+        out[:self.n] = sla.lu_solve(self.lu, rhs[:self.n], check_finite=False)
+        return out
+
+
+def make_swimmer(config):
+    """The free-swimming system of ``config`` (``body.motion = "free"``)."""
+    from flagwrap.body.multiblob import cell_body_blobs
+    from flagwrap.hydrodynamics.mobility import RPYMobility
+    from flagwrap.system.rod_system import RodSystem
+
+    fil = config.filament
+    inner = RodSystem(config, mobility=RPYMobility(fil.bead_radius / fil.length))
+    blobs, radii = cell_body_blobs(config)
+    return SwimmerSystem(inner, blobs, radii)
+
+
