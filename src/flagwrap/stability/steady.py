@@ -130,7 +130,7 @@ def newton(frame, machin: float, z0: np.ndarray, base0, step_tol: float = 1e-10,
 def initial_guess(frame):
     """The rest shape in the turning frame: ``(z, base)``."""
     s = frame.system
-    return s.initial_y()[:-1].copy(), s.frames0.copy()
+    return s.initial_y()[:frame.n].copy(), s.frames0.copy()
 
 
 def extrapolate(frame, a: SteadyState, b: SteadyState, machin: float) -> np.ndarray:

@@ -239,15 +239,27 @@ def resolve_m_max(config, m_start: float, m_max: float | None) -> float:
     return m
 
 
+def make_frame(config, omega: float):
+    """The turning frame of ``config``'s system at ``omega``: a free swimmer's
+    (:class:`~flagwrap.system.swimmer.SwimmerFrame`) or the rig's
+    (:class:`~flagwrap.system.rotating.RotatingFrame`; a fixed no-slip body's blob shell held
+    at one angle, ``blob_body``)."""
+    if config.body.free:
+        from flagwrap.system.swimmer import SwimmerFrame, make_swimmer
+
+        return SwimmerFrame(make_swimmer(config), omega)
+    from flagwrap.system.rod_system import RodSystem
+    from flagwrap.system.rotating import RotatingFrame
+
+    return RotatingFrame(RodSystem(config), omega, blob_body=config.body.no_slip)
+
+
 def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m_max=None,
                          **kw) -> StabilityResult:
     """:func:`find_critical` for a config: its system, turning at the reference speed in
     ``direction`` ("cw" or "ccw"), from ``m_start`` to ``m_max`` (:func:`resolve_m_max`).
     Refuses a bad range or a system the turning frame does not fit before any work."""
-    from flagwrap.system.rod_system import RodSystem
-    from flagwrap.system.rotating import RotatingFrame
-
     m_max = resolve_m_max(config, m_start, m_max)
-    frame = RotatingFrame(RodSystem(config), DIRECTIONS[direction])
+    frame = make_frame(config, DIRECTIONS[direction])
     return find_critical(frame, m_start=m_start, m_max=m_max, omega_si=config.omega,
                          machin_si=config.machin, **kw)

@@ -55,9 +55,11 @@ def subtract_rotation(f, system, info, omega: float, axis, A) -> None:
     f[s.sl_th] -= omega * (info.frames.t[s.ec:] @ axis)
 
 
-def check_rotating_frame(system) -> None:
+def check_rotating_frame(system, blob_body: bool = False) -> None:
     """Refuse a system whose equations are not autonomous in the turning frame (one line,
-    naming the part that breaks the symmetry about the motor axis)."""
+    naming the part that breaks the symmetry about the motor axis). ``blob_body``: accept a
+    no-slip blob body as if it were symmetric (its blobs held at one angle in the turning
+    frame: the linear-stability approximation of :class:`RotatingFrame`)."""
     joint = system.joint
     axis = getattr(joint, "axis", None)
     if axis is None or not hasattr(joint, "x_ref"):
@@ -72,7 +74,7 @@ def check_rotating_frame(system) -> None:
     g = np.asarray(system.gravity)
     if np.any(np.abs(g[:, :2]) > 0.0):
         raise UserInputError("the rotating frame needs gravity along the motor axis")
-    if not getattr(system.mobility, "axisymmetric", True):
+    if not blob_body and not getattr(system.mobility, "axisymmetric", True):
         raise UserInputError(
             f"the rotating frame needs a mobility symmetric about the motor axis; "
             f"{type(system.mobility).__name__} (a no-slip blob body) is not: use the lab frame")
@@ -89,10 +91,15 @@ class RotatingFrame:
 
     The unknowns are ``z = y[:-1]``, the lab state vector without the motor angle, written in
     the turning frame. The clamp is then at its reference position (``phi = 0``).
+
+    ``blob_body = True`` accepts a fixed no-slip body (:class:`~flagwrap.hydrodynamics.
+    polydisperse.FixedBodyMobility`): its blob shell, not quite symmetric about the axis, is
+    held at one angle in this frame, where it really turns at ``-omega``. The error is the
+    shell's ripple; docs/bacterium.md measures it by turning the shell between two runs.
     """
 
-    def __init__(self, system, omega: float):
-        check_rotating_frame(system)
+    def __init__(self, system, omega: float, blob_body: bool = False):
+        check_rotating_frame(system, blob_body=blob_body)
         if system.i_phi != system.ny - 1:
             raise ValueError("RotatingFrame: the motor angle must be the last unknown")
         self.system = system
@@ -140,26 +147,8 @@ class RotatingFrame:
         d = s.fd_step
         JG = 0.5 * (s.force_jacobian(y, base, info.G, delta=d)
                     + s.force_jacobian(y, base, info.G, delta=-d))
-        Mxx, mt = s.mobility_blocks(y)
-        sc = self.scale(machin)
-        J = np.empty((n, n))
-        J[:n3] = Mxx @ JG[:n3, :n]
-        J[n3:] = mt[:, None] * JG[n3:n, :n]
-        # (dMob/dx)[G]: the mobility at fixed forces, differenced bead by bead
-        if s.mobility.long_range:
-            xf = np.ascontiguousarray(info.x[s.nc:])
-            F = np.ascontiguousarray(info.G[:n3].reshape(-1, 3))
-            h = 1e-4 * s.bond  # the mobility varies on the bead radius: (h/a)^2 ~ 1e-7
-            xp = xf.copy()
-            for k in range(n3):
-                i, c = divmod(k, 3)
-                xp[i, c] = xf[i, c] + h
-                vp = s.mobility.apply(xp, F)
-                xp[i, c] = xf[i, c] - h
-                vm = s.mobility.apply(xp, F)
-                xp[i, c] = xf[i, c]
-                J[:n3, k] += (vp - vm).ravel() / (2.0 * h * s.machin)
-        J *= sc
+        J = self._mobility_jacobian(y, info, JG[:n, :n])
+        J *= self.scale(machin)
         om = self.omega
         for i in range(s.nb):  # - omega a x x'
             J[3 * i:3 * i + 3, 3 * i:3 * i + 3] -= om * self._A
@@ -178,6 +167,31 @@ class RotatingFrame:
             if j >= s.nc:
                 k = 3 * (j - s.nc)
                 J[r, k:k + 3] += om * g
+        return J
+
+
+    def _mobility_jacobian(self, y, info, JG) -> np.ndarray:
+        """``Mob (dG/dz) + (dMob/dx)[G]`` (n, n) at the system's Machin number; ``JG``: the
+        force Jacobian over ``z``. ``(dMob/dx)[G]``: the mobility at fixed forces,
+        differenced bead by bead."""
+        s, n, n3 = self.system, self.n, self.n3
+        Mxx, mt = s.mobility_blocks(y)
+        J = np.empty((n, n))
+        J[:n3] = Mxx @ JG[:n3]
+        J[n3:] = mt[:, None] * JG[n3:n]
+        if s.mobility.long_range:
+            xf = np.ascontiguousarray(info.x[s.nc:])
+            F = np.ascontiguousarray(info.G[:n3].reshape(-1, 3))
+            h = 1e-4 * s.bond  # the mobility varies on the bead radius: (h/a)^2 ~ 1e-7
+            xp = xf.copy()
+            for k in range(n3):
+                i, c = divmod(k, 3)
+                xp[i, c] = xf[i, c] + h
+                vp = s.mobility.apply(xp, F)
+                xp[i, c] = xf[i, c] - h
+                vm = s.mobility.apply(xp, F)
+                xp[i, c] = xf[i, c]
+                J[:n3, k] += (vp - vm).ravel() / (2.0 * h * s.machin)
         return J
 
 

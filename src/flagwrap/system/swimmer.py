@@ -47,6 +47,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from flagwrap.system.layout import DofLayout
+from flagwrap.system.rotating import (RotatingFrame, check_rotating_frame, cross_matrix,
+                                      subtract_rotation)
 
 
 def quaternion_matrix(q) -> np.ndarray:
@@ -265,6 +267,67 @@ class SwimmerW:
         out = np.array(rhs, float)
         out[:self.n] = sla.lu_solve(self.lu, rhs[:self.n], check_finite=False)
         return out
+
+
+class SwimmerFrame:
+    """The free swimmer in the frame turning with its motor relative to the body, for linear
+    stability (:mod:`flagwrap.stability`): the interface of
+    :class:`~flagwrap.system.rotating.RotatingFrame`, whose rotation terms and Jacobian
+    assembly it reuses.
+
+    Unknowns ``z``: the filament's (positions and twists, no motor angle) in this frame. A
+    steady state here is a filament turning rigidly with the motor while the body turns and
+    swims steadily in body axes (a helical path in the lab). The blob shell, not quite
+    symmetric about the axis, is held at one angle in this frame (as ``blob_body`` in the
+    fixed case); the pose is not an unknown (nothing depends on it).
+    """
+
+    def __init__(self, swimmer, omega: float):
+        check_rotating_frame(swimmer.inner)
+        self.system = swimmer
+        self.omega = float(omega)
+        self.axis = np.asarray(swimmer.joint.axis, float)
+        self.n = swimmer.n_in - 1
+        self.n3 = 3 * swimmer.nb
+        self._A = cross_matrix(self.axis)
+
+    def full(self, z) -> np.ndarray:
+        s = self.system
+        y = np.zeros(s.ny)
+        y[:self.n] = z
+        y[s.sl_q.start] = 1.0
+        return y
+
+    def scale(self, machin) -> float:
+        return 1.0 if machin is None else self.system.machin / float(machin)
+
+    def velocity(self, z, base, machin=None):
+        s = self.system
+        y = self.full(z)
+        info = s.forces(y, base)
+        f = s.apply_mobility(y, info.G)[:s.n_in]
+        f *= self.scale(machin)
+        subtract_rotation(f, s.inner, info, self.omega, self.axis, self._A)
+        return f[:self.n], info
+
+    def _mobility_jacobian(self, y, info, JG) -> np.ndarray:
+        """``A (dG/dz) + (dA/dx)[G]``: ``A`` dense (:meth:`SwimmerSystem.mobility_matrix`),
+        its change with the bead positions by central differences at fixed forces."""
+        s, n, n3 = self.system, self.n, self.n3
+        J = s.mobility_matrix(y)[:n, :n] @ JG
+        h = 1e-4 * s.bond  # as RotatingFrame: the mobility varies on the bead radius
+        yp = y.copy()
+        for k in range(n3):
+            yp[k] = y[k] + h
+            vp = s.apply_mobility(yp, info.G)[:n]
+            yp[k] = y[k] - h
+            vm = s.apply_mobility(yp, info.G)[:n]
+            yp[k] = y[k]
+            J[:, k] += (vp - vm) / (2.0 * h)
+        return J
+
+    # the frame's Jacobian: its force Jacobian, this mobility part, its exact rotation terms
+    jacobian = RotatingFrame.jacobian
 
 
 def make_swimmer(config):
