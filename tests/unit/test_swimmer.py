@@ -294,7 +294,7 @@ def test_fixed_no_slip_body_is_wired_and_keeps_the_paper_keys():
     cfg = make_config()
     ns = cfg.replace(body=dataclasses.replace(cfg.body, surface="no-slip"))
     s = make_system(ns)
-    assert isinstance(s.mobility, FixedBodyMobility) and len(s.mobility.blobs) == 375
+    assert isinstance(s.mobility, FixedBodyMobility) and len(s.mobility.blobs) == 344
     # defaults leave the stored keys of the paper cases as they were
     assert "surface" not in cfg.to_dict(for_hash=True)["body"]
     assert ns.to_dict(for_hash=True)["body"]["surface"] == "no-slip"
