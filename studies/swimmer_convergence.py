@@ -92,7 +92,9 @@ def order_and_limit(h, f):
     q = (f1 - f2) / (f2 - f3)
     if not q > 0:
         return math.nan, math.nan
-    g = lambda p: (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - q
+    def g(p):
+        return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - q
+
     try:
         p = brentq(g, 0.05, 12.0)
     except ValueError:

@@ -405,6 +405,18 @@ class Motor:
     frequency: float | None = None
     machin: float | None = None
     protocol: tuple[Phase, ...] = field(default_factory=paper_protocol)
+    kind: str = "speed"
+    stall_torque: float | None = None
+    zero_load_speed: float | None = None
+
+    #: ``kind``: what the motor prescribes (:mod:`flagwrap.motor.drive`). "speed" (default):
+    #: the rate, relative to the body, phase by phase. "torque": the torque ``stall_torque``
+    #: [N m], in each phase's direction. "torque-speed": the linear curve
+    #: ``tau = stall_torque (1 - rate / (2 pi zero_load_speed))`` [N m, Hz] (the bacterial
+    #: motor's, from stall to zero load: docs/bacterium.md). For the torque kinds a phase's
+    #: ``turns`` counts reference periods ``2 pi / omega`` of time, and its speed must be 1.
+    KINDS = ("speed", "torque", "torque-speed")
+    HASH_OMIT_DEFAULTS = {"kind": "speed"}
 
     def __post_init__(self):
         if (self.frequency is None) == (self.machin is None):
@@ -417,6 +429,27 @@ class Motor:
         if not prot:
             raise UserInputError("motor.protocol must have at least one phase")
         _set(self, "protocol", prot)
+        if self.kind not in self.KINDS:
+            raise UserInputError(f"motor.kind must be one of {', '.join(self.KINDS)}, got {self.kind!r}")
+        if self.kind == "speed":
+            for key in ("stall_torque", "zero_load_speed"):
+                if getattr(self, key) is not None:
+                    raise UserInputError(f"motor.{key} needs motor.kind = 'torque' or "
+                                         "'torque-speed' (a speed motor prescribes its rate)")
+            return
+        if self.stall_torque is None:
+            raise UserInputError(f"motor.kind = {self.kind!r} needs motor.stall_torque [N m] > 0")
+        _positive("motor.stall_torque", self.stall_torque, "N m")
+        if self.kind == "torque-speed":
+            if self.zero_load_speed is None:
+                raise UserInputError("motor.kind = 'torque-speed' needs motor.zero_load_speed [Hz] > 0")
+            _positive("motor.zero_load_speed", self.zero_load_speed, "Hz")
+        elif self.zero_load_speed is not None:
+            raise UserInputError("motor.zero_load_speed needs motor.kind = 'torque-speed'")
+        for p in prot:
+            if p.direction != "stop" and p.speed != 1.0:
+                raise UserInputError(f"motor.protocol speed = {p.speed:g}: a {self.kind} motor "
+                                     "sets its own speed; leave the phases' speed at 1")
 
 
 @dataclass(frozen=True)
@@ -773,6 +806,15 @@ class Config:
                     f"{MAX_BODY_OVER_LENGTH * fil.length:.3g} m (or set body.enabled = false)")
         if self.body.no_slip or self.body.free:
             self._check_surface_body()
+        if self.motor.kind != "speed":
+            if self.numerics.linear_solver not in ("auto", "dense"):
+                raise UserInputError(
+                    f"numerics.linear_solver = {self.numerics.linear_solver!r} cannot take a "
+                    f"motor.kind = {self.motor.kind!r} motor (its row couples the whole W): use "
+                    "'auto' or 'dense'")
+            if self.numerics.frame != "lab":
+                raise UserInputError(f"numerics.frame = 'rotating' needs motor.kind = 'speed' "
+                                     f"(a {self.motor.kind} motor's rate is not known ahead)")
         # beads that are not contour neighbours must not overlap in the stress-free helix
         from flagwrap.geometry.helix import min_nonlocal_distance
 
@@ -941,4 +983,7 @@ class Config:
             for k, v in CellBody.HASH_OMIT_DEFAULTS.items():
                 if d["body"].get(k) == v:
                     d["body"].pop(k)
+            for k, v in Motor.HASH_OMIT_DEFAULTS.items():
+                if d["motor"].get(k) == v:
+                    d["motor"].pop(k)
         return d

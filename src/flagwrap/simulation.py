@@ -122,8 +122,9 @@ class Simulation:
         # leave the records with different lengths
         phi = y[s.i_phi]
         hook = s.joint.observables(info.x, info.theta, m1, m2, info.frames, s.rest)
-        row = (t, info.x.copy(), info.theta.copy(), m1, phi, omega,
-               s.motor_torque(info, phi, omega), info.elastic_energy, info.contact_energy,
+        rate = s.motor_rate(y, info_in, omega)  # a torque motor's own rate
+        row = (t, info.x.copy(), info.theta.copy(), m1, phi, rate,
+               s.motor_torque(info_in, phi, omega), info.elastic_energy, info.contact_energy,
                float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf,
                self._strain(info), info.interaction_energy) + hook
         body = getattr(s, "body_record", None)  # a moving body's pose and velocities

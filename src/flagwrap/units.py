@@ -139,6 +139,13 @@ class Scales:
     def from_torque(self, n):
         return n * self.torque
 
+    def to_torque(self, n_si):
+        return n_si / self.torque
+
+    def to_rate(self, hz):
+        """A frequency [Hz] as an angular velocity in core units (``2 pi f / omega``)."""
+        return 2.0 * math.pi * hz / self.omega
+
 
 def hook_spring(hook_modulus: float, hook_length: float, bending: float, length: float) -> float:
     """A lumped joint's spring ``K_h / l_h`` (bending ``A_h`` or twist ``C_h`` over the hook

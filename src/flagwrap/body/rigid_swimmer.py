@@ -63,7 +63,7 @@ def rigid_swimmer(body_points, body_radii, helix_points, helix_radius, axis=(0.0
     X = np.concatenate([B, H])
     M = PolydisperseRPY(radii).matrix(np.ascontiguousarray(X))
     K = geometric_matrix(X)
-    KB, KH = K[:3 * nb], K[3 * nb:]
+    KH = K[3 * nb:]
     n = 3 * (nb + nh)
     e = np.concatenate([np.zeros(3), a])  # [0; a]
     # unknowns [lambda (n), V_B (6), tau (1)]

@@ -45,7 +45,7 @@ class DenseW:
     factorises that buffer in place, without the transposing copy a C-ordered ``W`` needs.
     """
 
-    def __init__(self, system, y, base, G0, gamma_h, reuse: bool = False):
+    def __init__(self, system, y, base, G0, gamma_h, reuse: bool = False, omega=None):
         from flagwrap.system.kernels import w_transpose_dense
 
         rows, cols, vals = system.force_jacobian_coo(y, base, G0)
@@ -58,6 +58,8 @@ class DenseW:
             if reuse:
                 system._wt_buffer = WT
         w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT)
+        if system.drive.free:
+            add_motor_rows(WT, system, y, base, gamma_h, omega, Mxx, mt)
         try:
             self.lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
         except (ValueError, np.linalg.LinAlgError) as exc:
@@ -67,6 +69,20 @@ class DenseW:
 
     def solve(self, rhs):
         return sla.lu_solve(self.lu, rhs, check_finite=False)
+
+
+def add_motor_rows(WT, system, y, base, gamma_h, omega, Mxx, mt) -> None:
+    """A torque motor's terms of ``W = I - gamma h Mob J`` in ``WT = W^T``: the force
+    Jacobian's motor-angle column (times ``Mob``) and the motor's row
+    (:meth:`~flagwrap.system.rod_system.RodSystem.motor_jacobian`)."""
+    if omega is None:
+        raise ValueError("a torque motor's W needs the phase's omega")
+    col, row, _ = system.motor_jacobian(y, base, omega)
+    i, n3 = system.i_phi, 3 * system.nb
+    WT[:, i] = -gamma_h * row
+    WT[i, i] += 1.0
+    WT[i, :n3] -= gamma_h * (Mxx @ col[:n3])
+    WT[i, n3:i] -= gamma_h * mt * col[n3:i]
 
 
 def preconditioner_width(system) -> int:
@@ -331,13 +347,17 @@ class SparseW:
         return self.lu.solve(rhs)
 
 
-def make_w(kind, system, y, base, G0, gamma_h, err_scale=None):
+def make_w(kind, system, y, base, G0, gamma_h, err_scale=None, omega=None):
     """The stage solver ``kind`` for ``W = I - gamma_h Mob J`` at ``y``; ``err_scale``: the
     absolute accuracy each unknown of a solution needs (iterative solvers stop on it).
     A system with its own stage solver (``system.make_w``, e.g. the free swimmer's) gets it."""
     own = getattr(system, "make_w", None)
     if own is not None:
-        return own(kind, y, base, G0, gamma_h, err_scale)
+        return own(kind, y, base, G0, gamma_h, err_scale, omega)
+    if system.drive.free:  # the motor's row and column: only the dense W has them
+        if kind not in ("auto", "dense"):
+            raise ValueError(f"linear solver {kind!r} cannot take a torque motor: use 'dense'")
+        return DenseW(system, y, base, G0, gamma_h, reuse=True, omega=omega)
     if kind == "auto":
         if not system.mobility.long_range:
             kind = "banded"

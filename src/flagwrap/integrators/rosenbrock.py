@@ -43,7 +43,7 @@ class RosenbrockW(AdaptiveMixin, Integrator):
             # stage increments u_i enter y_new and the error estimate with O(1) weights, so
             # an iterative solve needs each to kappa x the step tolerance
             W = make_w(self.linear_solver, system, y, base, info.G, gh,
-                       err_scale=error_weights(system, self.tol))
+                       err_scale=error_weights(system, self.tol), omega=omega)
         except SingularW as exc:
             return self.reject(h, f"singular W ({exc})")
         a, c = tb.a, tb.c

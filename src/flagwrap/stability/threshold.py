@@ -259,6 +259,11 @@ def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m
     """:func:`find_critical` for a config: its system, turning at the reference speed in
     ``direction`` ("cw" or "ccw"), from ``m_start`` to ``m_max`` (:func:`resolve_m_max`).
     Refuses a bad range or a system the turning frame does not fit before any work."""
+    if config.motor.kind != "speed":
+        from flagwrap.errors import UserInputError
+
+        raise UserInputError(f"stability needs motor.kind = 'speed' (the threshold is in the "
+                             f"motor's rate), got {config.motor.kind!r}")
     m_max = resolve_m_max(config, m_start, m_max)
     frame = make_frame(config, DIRECTIONS[direction])
     return find_critical(frame, m_start=m_start, m_max=m_max, omega_si=config.omega,

@@ -59,10 +59,12 @@ class DofLayout:
         self._by_name = {b.name: b for b in out}
 
     @classmethod
-    def clamped_filament(cls, n_free_beads: int, n_free_bonds: int) -> "DofLayout":
-        """One filament behind a motor clamp: free bead positions, free twist angles, motor angle."""
+    def clamped_filament(cls, n_free_beads: int, n_free_bonds: int,
+                         motor: str = "prescribed") -> "DofLayout":
+        """One filament behind a motor clamp: free bead positions, free twist angles, motor
+        angle (``motor = "angle"``: a torque-driven motor's angle, an unknown like the rest)."""
         return cls([("x", "position", 3 * n_free_beads), ("theta", "angle", n_free_bonds),
-                    ("phi", "prescribed", 1)])
+                    ("phi", motor, 1)])
 
     def __getitem__(self, name: str) -> slice:
         return self._by_name[name].slice

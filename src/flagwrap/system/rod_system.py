@@ -32,6 +32,7 @@ from flagwrap.elasticity.rod import Frames, RestState, initial_frames, rest_stat
 from flagwrap.geometry.helix import filament_positions
 from flagwrap.hydrodynamics.mobility import make_mobility
 from flagwrap.joints import make_joint
+from flagwrap.motor.drive import make_drive
 from flagwrap.motor.protocol import Schedule
 from flagwrap.system.layout import DofLayout
 
@@ -93,7 +94,8 @@ class RodSystem:
         self.nc, self.ec = nc, ec
         self.nb = N - nc  # free beads
         self.ne = N - 1 - ec  # free bonds
-        self.layout = DofLayout.clamped_filament(self.nb, self.ne)
+        self.layout = DofLayout.clamped_filament(
+            self.nb, self.ne, "prescribed" if config.motor.kind == "speed" else "angle")
         self.ny = self.layout.size
         self.sl_x = self.layout["x"]
         self.sl_th = self.layout["theta"]
@@ -135,6 +137,7 @@ class RodSystem:
             per_bead[1:-1] = 0.5 * (lb[:-1] + lb[1:])
             self.gravity[:, 2] = config.gravity_number * per_bead
         self.schedule = Schedule(config.motor.protocol)
+        self.drive = make_drive(config, zeta=self.machin * self.rot_drag[0])
         self._colors = None
         self.interactions = self._config_interactions() + list(interactions)
 
@@ -176,7 +179,8 @@ class RodSystem:
             raise UserInputError(
                 f"body overlaps the filament at the start: bead {i + self.nc} is "
                 f"{-d[i] * L:.3g} m inside the cell body (initial.perturbation = "
-                f"{self.config.initial.perturbation:g} m, filament.n_beads = {self.config.filament.n_beads}); "
+                f"{self.config.initial.perturbation:g} m, filament.n_beads = "
+                f"{self.config.filament.n_beads}); "
                 "use a smaller initial.perturbation, another initial.seed, or more beads")
 
     def pack(self, x, theta, phi) -> np.ndarray:
@@ -282,8 +286,48 @@ class RodSystem:
     def velocity(self, y, info: ForceInfo, omega: float) -> np.ndarray:
         """``dy/dt`` at ``y`` from the forces ``info`` already computed there."""
         f = self.apply_mobility(y, info.G)
-        f[self.i_phi] = omega
+        f[self.i_phi] = self.motor_rate(y, info, omega)
         return f
+
+    def motor_rate(self, y, info: ForceInfo, omega: float) -> float:
+        """``dphi/dt``: the protocol's ``omega`` for a speed motor, the rotor's torque balance
+        for a torque motor (:mod:`flagwrap.motor.drive`)."""
+        if not self.drive.free:
+            return omega
+        return self.drive.rate(omega, self.motor_force(y, info))
+
+    def motor_force(self, y, info: ForceInfo) -> float:
+        """``G_phi = -dE/dphi``, the filament's elastic torque on the rotor [A/L]."""
+        return -self.clamp.generalized_force(y[self.i_phi], info.grad_x, info.grad_theta)
+
+    def motor_jacobian(self, y, base, omega: float):
+        """For a torque motor: ``(dG/dphi, m dG_phi/dy, m)`` by central differences, the
+        force Jacobian's motor-angle column and the motor's row of ``Mob J`` (``m`` the
+        drive's mobility), over the unknowns the rotor couples to (the clamp's neighbours);
+        ``None`` for a speed motor, whose angle is prescribed."""
+        if not self.drive.free:
+            return None
+        h = self.fd_step
+        col = np.zeros(self.ny)
+        yp = np.array(y, float)
+        yp[self.i_phi] = y[self.i_phi] + h
+        Gp = self.forces(yp, base).G
+        yp[self.i_phi] = y[self.i_phi] - h
+        Gm = self.forces(yp, base).G
+        col[:] = (Gp - Gm) / (2 * h)
+        col[self.i_phi] = 0.0
+        m = self.drive.mobility(omega)
+        row = np.zeros(self.ny)
+        near = [3 * k + c for k in range(min(3, self.nb)) for c in range(3)]
+        near += [self.sl_th.start + j for j in range(min(3, self.ne))] + [self.i_phi]
+        for k in near:
+            yp = np.array(y, float)
+            yp[k] = y[k] + h
+            gp = self.motor_force(yp, self.forces(yp, base))
+            yp[k] = y[k] - h
+            gm = self.motor_force(yp, self.forces(yp, base))
+            row[k] = m * (gp - gm) / (2 * h)
+        return col, row, m
 
     def rhs(self, y, base, omega):
         info = self.forces(y, base)
@@ -433,7 +477,10 @@ class RodSystem:
         """Axial torque the motor supplies [A/L], about the outward axis (positive = CCW).
 
         Torque balance on the driven DOF: ``N_m = dE/dphi + zeta_r0 omega`` with
-        ``zeta_r0 = M 8 pi a^3 w_0`` the rotational drag of the clamped bond.
+        ``zeta_r0 = M 8 pi a^3 w_0`` the rotational drag of the clamped bond. A torque motor
+        exerts its own torque (:mod:`flagwrap.motor.drive`) at the rate it turns.
         """
         dEdphi = self.clamp.generalized_force(phi, info.grad_x, info.grad_theta)
-        return dEdphi + self.machin * self.rot_drag[0] * omega
+        if not self.drive.free:
+            return dEdphi + self.machin * self.rot_drag[0] * omega
+        return self.drive.torque(self.drive.rate(omega, -dEdphi), omega)

@@ -257,6 +257,10 @@ class RotatingSystem:
     def interaction_jacobian_coo(self, y, which: str = "all"):
         return self.inner.interaction_jacobian_coo(self._at_zero(y), which)
 
+    def motor_torque(self, info, phi: float, omega: float) -> float:
+        """The lab system's, from forces evaluated here with the clamp at ``phi = 0``."""
+        return self.inner.motor_torque(info, 0.0, omega)
+
     def record_view(self, y, info):
         """``info`` with its positions, gradients and reference frames turned by the motor
         angle into the lab frame (twist angles and energies are frame-independent)."""

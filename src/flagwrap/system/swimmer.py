@@ -176,7 +176,7 @@ class SwimmerSystem:
 
     def velocity(self, y, info, omega: float) -> np.ndarray:
         f = self.apply_mobility(y, info.G)
-        f[self.inner.i_phi] = omega
+        f[self.inner.i_phi] = self.inner.motor_rate(y, info, omega)
         return f
 
     def rhs(self, y, base, omega):
@@ -215,13 +215,13 @@ class SwimmerSystem:
         A += D.T @ self.body_mobility @ D
         return A / s.machin
 
-    def make_w(self, kind, y, base, G0, gamma_h, err_scale=None):
+    def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
         """The stage solver: dense LU of ``I - gamma h A J`` on the filament, identity on the
         pose (module docstring), with ``A`` less the surface's screening
         (:meth:`mobility_matrix`); every ``kind`` gets it. Measured (docs/bacterium.md):
         0.3 turn of the 61-bead Fig. 4(a) swimmer takes 537 steps against 506 with the exact
         ``A``, at half the time per step; the free-space mobility alone (no body term) 567."""
-        return SwimmerW(self, y, base, G0, gamma_h)
+        return SwimmerW(self, y, base, G0, gamma_h, omega)
 
     # output --------------------------------------------------------------------------------
     def record_view(self, y, info):
@@ -248,13 +248,20 @@ class SwimmerSystem:
 class SwimmerW:
     """Dense LU of the swimmer's ``W`` (:meth:`SwimmerSystem.make_w`)."""
 
-    def __init__(self, system, y, base, G0, gamma_h):
+    def __init__(self, system, y, base, G0, gamma_h, omega=None):
         from flagwrap.integrators.linear import SingularW
 
         n = system.n_in
-        J = system.inner.force_jacobian(y[:n], base, G0[:n])
+        inner = system.inner
+        J = inner.force_jacobian(y[:n], base, G0[:n])
+        motor = inner.drive.free and inner.motor_jacobian(y[:n], base, omega)
+        if motor:  # a torque motor: the force Jacobian's motor column, the motor's row
+            J[:, inner.i_phi] = motor[0]
         W = -gamma_h * (system.mobility_matrix(y, screening=False) @ J)
         W[np.diag_indices(n)] += 1.0
+        if motor:
+            W[inner.i_phi] = -gamma_h * motor[1]
+            W[inner.i_phi, inner.i_phi] += 1.0
         self.n = n
         try:
             self.lu = sla.lu_factor(W, overwrite_a=True, check_finite=False)
