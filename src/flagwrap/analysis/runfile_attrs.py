@@ -51,7 +51,12 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None) -> BucklingAna
         raise UserInputError("run file has fewer than 2 saved frames")
     a = analysis if analysis is not None else BucklingAnalysis()
     tq = ds["motor_torque_reduced"].values if "motor_torque_reduced" in ds.variables else None
-    return a.compute(ds["turns"].values, ds["position"].values, ds["omega"].values,
+    x = ds["position"].values
+    if "body_position" in ds.variables:  # a free swimmer: the filament seen from its body
+        from flagwrap.observables.swimming import body_frame
+
+        x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
+    return a.compute(ds["turns"].values, x, ds["omega"].values,
                      float(ds.attrs["length"]), cfg.body.resolved_radius(R),
                      cfg.body.resolved_length(R), tq)
 
@@ -116,12 +121,17 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
     if write:
         write_dataset_atomic(annotate(ds, a), path)
     res = {**a.summary(), **joint_summary(ds)}
+    from flagwrap.observables.swimming import swimming_summary
+
+    res["swimming"] = swimming_summary(ds)
     res["params"] = a.params()
     res["path"] = str(path)
     res["run_status"] = str(ds.attrs.get("status", ""))
     return res
 
 
-def jsonable(res: dict) -> dict:
-    """NaN -> None so that the result is valid JSON."""
-    return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in res.items()}
+def jsonable(res):
+    """NaN -> None at every depth, so that the result is valid JSON (the sweep store's)."""
+    from flagwrap.sweep.store import jsonable as _jsonable
+
+    return _jsonable(res)

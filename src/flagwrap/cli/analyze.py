@@ -2,7 +2,9 @@
 
 Prints a summary per run file and writes the results into it (attributes ``analysis_*``,
 variables ``free_end_height``, ``winding_turns``, ``contact_fraction``, ``perversion_bead``;
-atomic rewrite) unless ``--no-write``. Criteria and defaults: docs/analysis.md.
+atomic rewrite) unless ``--no-write``. Criteria and defaults: docs/analysis.md. A free
+swimmer's filament is analysed in its body's frame, and its swimming is reported per motor
+phase (:mod:`flagwrap.observables.swimming`).
 
 Examples::
 
@@ -74,4 +76,9 @@ def run(args) -> int:
         for key, label, fmt in ROWS:
             v = res[key]
             print(f"  {label:<30s} {fmt.format(v) if not (isinstance(v, float) and v != v) else '-'}")
+        for ph in res["swimming"]:  # a free swimmer, phase by phase (second half of each)
+            print(f"  swimming, {ph['direction']} phase ({ph['t0']:.3g}-{ph['t1']:.3g} s): "
+                  f"speed {ph['speed'] * 1e6:+.4g} um/s (+ body first), body rotation "
+                  f"{ph['body_rotation_hz']:+.4g} Hz, motor {ph['motor_rate_hz']:+.4g} Hz, "
+                  f"{ph['displacement_per_turn'] * 1e9:+.4g} nm per motor turn")
     return 0

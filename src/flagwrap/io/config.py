@@ -6,7 +6,9 @@ evaluated: TOML values are data only.
 
 Units: SI by default. An optional ``[units]`` table rescales inputs, e.g.
 ``length = "mm"`` (lengths of ``filament`` and ``body``), ``pressure = "MPa"`` (Young's
-modulus), ``viscosity = "mPa s"``, ``density = "g/cm3"``.
+modulus), ``viscosity = "mPa s"``, ``density = "g/cm3"``, ``torque = "pN nm"`` (the motor's
+stall torque), ``bending = "pN um2"`` (the hook's bending and twist moduli). A bacterium is
+given in um, pN and Hz (examples/s_putrefaciens.toml).
 """
 
 from __future__ import annotations
@@ -40,9 +42,12 @@ _LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "micron": 1e-6, "nm": 1e-9}
 _PRESSURE = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
 _VISCOSITY = {"Pa s": 1.0, "mPa s": 1e-3, "cP": 1e-3}
 _DENSITY = {"kg/m3": 1.0, "g/cm3": 1e3}
+_TORQUE = {"N m": 1.0, "pN nm": 1e-21, "pN um": 1e-18}
+_BENDING = {"N m2": 1.0, "pN um2": 1e-24, "pN nm2": 1e-30}
+_UNIT_KEYS = ("bending", "density", "length", "pressure", "torque", "viscosity")
 _LENGTH_KEYS = {
     "filament": ("length", "helix_radius", "pitch", "cross_section_radius", "hydrodynamic_radius"),
-    "body": ("radius", "cylinder_length"),
+    "body": ("radius", "cylinder_length", "blob_spacing", "blob_radius"),
     "initial": ("perturbation",),
     "joint": ("hook_length",),
 }
@@ -95,13 +100,15 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
     if not isinstance(u, dict):
         raise UserInputError("[units] must be a table")
     for key in u:
-        if key not in ("length", "pressure", "viscosity", "density"):
+        if key not in _UNIT_KEYS:
             raise UserInputError(
-                f"unknown key units.{_show(key)}; allowed: density, length, pressure, viscosity")
+                f"unknown key units.{_show(key)}; allowed: {', '.join(_UNIT_KEYS)}")
     lf = _unit(u, "length", _LENGTH, "m")
     pf = _unit(u, "pressure", _PRESSURE, "Pa")
     vf = _unit(u, "viscosity", _VISCOSITY, "Pa s")
     df = _unit(u, "density", _DENSITY, "kg/m3")
+    tf = _unit(u, "torque", _TORQUE, "N m")
+    bf = _unit(u, "bending", _BENDING, "N m2")
     for req in ("filament", "motor"):
         if req not in data:
             raise UserInputError(f"missing required section [{req}]")
@@ -115,6 +122,10 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
             scale.update(youngs_modulus=pf, density=df)
         if section == "fluid":
             scale.update(viscosity=vf, density=df)
+        if section == "motor":
+            scale.update(stall_torque=tf)
+        if section == "joint":
+            scale.update(hook_bending_modulus=bf, hook_twist_modulus=bf)
         for key, factor in scale.items():
             # numbers only: a bool times a factor would become a float and pass validation
             if _is_number(table.get(key)):

@@ -1,0 +1,95 @@
+"""A free swimmer's observables from its run file: the filament in the body's frame, and per
+motor phase the swimming speed, the body's counter-rotation, the motor's rate and the
+displacement per motor turn (``flagwrap analyze``; docs/bacterium.md).
+
+Rates come from differences of the recorded pose and motor angle over the second half of each
+phase, not from the recorded instantaneous velocities: those are derivatives of a stiff
+state, which carry its error times the stiffness (docs/bacterium.md, "Checks").
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def quaternion_matrices(q: np.ndarray) -> np.ndarray:
+    """Rotation matrices (n, 3, 3) of unit quaternions ``q`` (n, 4) = (w, x, y, z)."""
+    q = q / np.linalg.norm(q, axis=1)[:, None]
+    w, x, y, z = q.T
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], 1)
+
+
+def body_frame(position: np.ndarray, body_position: np.ndarray,
+               body_orientation: np.ndarray) -> np.ndarray:
+    """Bead positions (time, bead, 3) in the body's frame: ``x' = R^T (x - X)``."""
+    R = quaternion_matrices(np.asarray(body_orientation, float))
+    d = np.asarray(position, float) - np.asarray(body_position, float)[:, None, :]
+    return np.einsum("tji,tbj->tbi", R, d)
+
+
+def _rotation_angle_about(R0: np.ndarray, R1: np.ndarray, axis: np.ndarray) -> float:
+    """Angle [rad] of the rotation ``R1 R0^T`` projected on ``axis`` (its rotation vector's
+    component along it), for a rotation below pi."""
+    D = R1 @ R0.T
+    c = max(-1.0, min(1.0, 0.5 * (np.trace(D) - 1.0)))
+    th = math.acos(c)
+    if th < 1e-12:
+        return 0.0
+    v = np.array([D[2, 1] - D[1, 2], D[0, 2] - D[2, 0], D[1, 0] - D[0, 1]]) / (2 * math.sin(th))
+    return float(th * (v @ axis))
+
+
+def phase_summary(t, phi, body_position, body_orientation, t0, t1) -> dict:
+    """The swimmer over ``[t0, t1]`` (SI: s, rad, m): its speed along the body axis (+ = body
+    first, away from the filament) [m/s], the body's rotation rate about its axis [Hz] (+ =
+    right-handed about the body axis +z, the sense opposite to a CCW motor), the motor's
+    rate relative to the body [Hz] and the displacement along the axis per motor turn [m]."""
+    t = np.asarray(t, float)
+    k = np.flatnonzero((t >= t0 - 1e-12 * abs(t1)) & (t <= t1 + 1e-12 * abs(t1)))
+    nan = float("nan")
+    if len(k) < 2:
+        return dict(speed=nan, body_rotation_hz=nan, motor_rate_hz=nan, displacement_per_turn=nan)
+    i, j = k[0], k[-1]
+    R = quaternion_matrices(np.asarray(body_orientation, float)[[i, j]])
+    axis = R[0][:, 2] + R[1][:, 2]
+    axis /= np.linalg.norm(axis)
+    dt = t[j] - t[i]
+    dX = float((np.asarray(body_position)[j] - np.asarray(body_position)[i]) @ axis)
+    # the body's turn over the window, in pieces below pi
+    ang = 0.0
+    Rk = quaternion_matrices(np.asarray(body_orientation, float)[k])
+    for a, b in zip(Rk[:-1], Rk[1:]):
+        ang += _rotation_angle_about(a, b, axis)
+    dphi = float(np.asarray(phi)[j] - np.asarray(phi)[i])
+    return dict(speed=dX / dt, body_rotation_hz=ang / dt / (2 * math.pi),
+                motor_rate_hz=dphi / dt / (2 * math.pi),
+                displacement_per_turn=dX / (abs(dphi) / (2 * math.pi)) if dphi else nan)
+
+
+def swimming_summary(ds) -> list[dict]:
+    """One :func:`phase_summary` per motor phase of a free swimmer's run file (the second half
+    of each phase), with the phase's direction; an empty list for a fixed body."""
+    if "body_position" not in ds.variables:
+        return []
+    from flagwrap.io.runfile import config_of
+    from flagwrap.motor.protocol import Schedule
+
+    cfg = config_of(ds)
+    sched = Schedule(cfg.motor.protocol)
+    T = 1.0 / cfg.scales.omega  # core time unit [s]
+    t = ds["time"].values
+    out = []
+    for seg in sched.segments:
+        t0, t1 = seg.t0 * T, min(seg.t1 * T, float(t[-1]))
+        if t1 <= t0:
+            break
+        row = phase_summary(t, ds["motor_angle"].values, ds["body_position"].values,
+                            ds["body_orientation"].values, 0.5 * (t0 + t1), t1)
+        row.update(direction=seg.label, t0=t0, t1=t1)
+        out.append(row)
+    return out
