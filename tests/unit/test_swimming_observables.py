@@ -75,3 +75,57 @@ def test_analyze_reports_a_free_swimmer_phase_by_phase(tmp_path):
     # the motor keeps its rate relative to the body; the body turns against it
     assert math.isclose(sw[0]["motor_rate_hz"], cfg.omega / (2 * math.pi), rel_tol=1e-9)
     assert sw[0]["body_rotation_hz"] > 0 > sw[1]["body_rotation_hz"]
+
+
+def test_the_moving_body_is_drawn_and_exported_where_it_is(tmp_path):
+    # a synthetic free-swimmer run file: the body shifted by d and turned by 90 deg about x;
+    # the renderer's body polygons and the VTK body file must carry that pose
+    import dataclasses
+
+    from conftest import make_config, paper_filament
+    from flagwrap.io.runfile import trajectory_dataset
+    from flagwrap.io.vtk import export_vtk
+    from flagwrap.plotting.render import CAMERAS, Renderer, body_poses, scene_of, view_limits
+    from flagwrap.simulation import Trajectory
+
+    cfg = make_config(protocol=(("ccw", 0.1),), filament=paper_filament(n_beads=21))
+    cfg = cfg.replace(body=dataclasses.replace(cfg.body, surface="no-slip", motion="free",
+                                               blob_spacing=0.025))
+    from flagwrap.system.swimmer import make_swimmer
+
+    s = make_swimmer(cfg)
+    y = s.initial_y()
+    info = s.forces(y, s.frames0)
+    tr = Trajectory(cfg)
+    q = _quat([1, 0, 0], math.pi / 2)
+    d = np.array([0.01, -0.02, 0.05]) / cfg.filament.length  # core units
+    for k in range(2):
+        tr.t.append(0.1 * k)
+        tr.x.append(info.x)
+        tr.theta.append(info.theta)
+        tr.m1.append(np.tile([1.0, 0, 0], (len(info.theta), 1)))
+        for name in ("phi", "omega", "motor_torque", "elastic_energy", "contact_energy",
+                     "min_distance", "max_strain", "interaction_energy", "hook_angle",
+                     "hook_torque", "hook_twist_torque"):
+            getattr(tr, name).append(0.0)
+        tr.body.append(np.concatenate([k * d, q if k else [1.0, 0, 0, 0], np.zeros(6)]))
+    ds = trajectory_dataset(tr)
+    poses = body_poses(ds)
+    assert np.allclose(poses[0][1], d * cfg.filament.length)
+    scene = scene_of(ds)
+    r = Renderer(scene)
+    top = scene.body_radius + scene.body_length
+    # turned by 90 deg about x, the body's axis (+z) now points along -y
+    ulim, zlim = view_limits(ds["position"].values, scene, poses=poses)
+    assert ulim[1] - ulim[0] >= top
+    p0, _ = r.polygons(ds["position"].values[1], CAMERAS[0])
+    p1, _ = r.polygons(ds["position"].values[1], CAMERAS[0], (poses[0][1], poses[1][1]))
+    def height(polys):
+        z = np.concatenate(polys)[:, 1]
+        return z.max() - z.min()
+
+    # the upright body spans its height; lying along -y it spans ~its diameter vertically
+    assert height(p0) - height(p1) > 0.5 * scene.body_length
+    pvd = export_vtk(ds, tmp_path / "vtk", with_forces=False)
+    files = sorted(p.name for p in pvd.parent.glob("body_*.vtp"))
+    assert len(files) == 2

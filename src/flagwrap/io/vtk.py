@@ -4,7 +4,8 @@ Written by hand (ASCII VTK XML, format 0.1), so no VTK library is needed. Layout
 
     DIR/run.pvd            time series; open this in ParaView
     DIR/filament_0000.vtp  one polyline per saved frame (N points, one line cell)
-    DIR/body.vtp           the cell body as a closed triangle surface (if the run has a body)
+    DIR/body.vtp           the cell body as a closed triangle surface (if the run has a body;
+                           a free swimmer's moves: DIR/body_NNNN.vtp, one per frame)
 
 Time values in the .pvd are ``t/T`` (the paper's clock) by default, or seconds. Coordinates are
 in metres, body axis +z, clamp at the origin (see :mod:`flagwrap.io.runfile`).
@@ -272,7 +273,7 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
     """
     from flagwrap.errors import UserInputError
     from flagwrap.io.runfile import config_of
-    from flagwrap.plotting.render import body_surface, scene_of
+    from flagwrap.plotting.render import body_poses, body_surface, scene_of
 
     if time_unit not in ("turns", "seconds"):
         raise UserInputError(f"time unit must be 'turns' or 'seconds', got {time_unit!r}")
@@ -299,10 +300,17 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
         _write(d / name, polydata_xml(X[i], lines=line, point_data=pdata, cell_data=cdata))
         entries.append((float(tvals[i]), 0, name))
     scene = scene_of(ds)
-    if scene.has_body:
+    poses = body_poses(ds)
+    if scene.has_body and poses is None:
         v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around)
         _write(d / "body.vtp", polydata_xml(v, polys=f))
         entries += [(float(tvals[i]), 1, "body.vtp") for i in idx]
+    elif scene.has_body:  # a free swimmer: the body where it is, frame by frame
+        v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around)
+        for i in idx:
+            name = f"body_{i:0{width}d}.vtp"
+            _write(d / name, polydata_xml(v @ poses[1][i].T + poses[0][i], polys=f))
+            entries.append((float(tvals[i]), 1, name))
     pvd = d / "run.pvd"
     _write(pvd, pvd_xml(entries))  # last: a complete .pvd names only complete frames
     return pvd

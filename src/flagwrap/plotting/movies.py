@@ -122,7 +122,7 @@ class MovieFrames:
 
     def __init__(self, ds, fps: float = 25.0, speed: float | None = None,
                  size=DEFAULT_SIZE, renderer_kwargs: dict | None = None):
-        from flagwrap.plotting.render import Renderer, scene_of, view_limits
+        from flagwrap.plotting.render import Renderer, body_poses, scene_of, view_limits
 
         self.ds = ds
         self.fps = float(fps)
@@ -133,7 +133,8 @@ class MovieFrames:
         self.X = ds["position"].values
         self.scene = scene_of(ds)
         self.renderer = Renderer(self.scene, **(renderer_kwargs or {}))
-        self.ulim, self.zlim = view_limits(self.X, self.scene)
+        self.poses = body_poses(ds)  # a free swimmer's body, drawn where it is
+        self.ulim, self.zlim = view_limits(self.X, self.scene, poses=self.poses)
         self._fig = None
 
     def __len__(self) -> int:
@@ -201,8 +202,12 @@ class MovieFrames:
         # direction of the nearest earlier saved frame (ties at a switch: the new direction)
         j = min(int(np.searchsorted(self.time, tq, side="right")), len(self.time) - 1)
         om = float(self.ds["omega"].values[max(j, 1) if tq > self.time[0] else 0])
+        pose = None
+        if self.poses is not None:  # the body's position interpolated as the beads are
+            Xb = np.array([np.interp(tq, self.time, self.poses[0][:, c]) for c in range(3)])
+            pose = (Xb, self.poses[1][i])
         for ax, cam in zip(self.ax_views, CAMERAS):
-            self.renderer.draw(ax, x, cam)
+            self.renderer.draw(ax, x, cam, pose)
         turn = self.turns[k]
         self._clock.set_text(f"t/T = {turn:6.2f}")
         if om < 0:

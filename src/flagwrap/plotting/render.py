@@ -108,6 +108,27 @@ def scene_of(ds) -> Scene:
                  float(ds.attrs["length"]))
 
 
+def body_poses(ds):
+    """A free swimmer's body poses per saved frame, ``(X (F, 3) [m], R (F, 3, 3))`` (body to
+    lab), or ``None`` for a fixed body (at the origin, axis +z)."""
+    if "body_position" not in ds.variables:
+        return None
+    from flagwrap.observables.swimming import quaternion_matrices
+
+    return ds["body_position"].values, quaternion_matrices(ds["body_orientation"].values)
+
+
+def body_outline(scene, poses) -> np.ndarray:
+    """Points (F * 10, 3) [m] that bound the moving body in every frame (for the view
+    limits): its pole and top on the axis, and the rim at the cap's equator and at the top,
+    a radius out along both cross directions."""
+    X, R = poses
+    Rc, top = scene.body_radius, scene.body_radius + scene.body_length
+    rim = [[sx * Rc, sy * Rc, z] for z in (Rc, top) for sx, sy in ((1, 0), (-1, 0), (0, 1), (0, -1))]
+    local = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, top]] + rim)
+    return (np.einsum("fij,kj->fki", R, local) + X[:, None, :]).reshape(-1, 3)
+
+
 # --------------------------------------------------------------------------------------------
 # meshes (pure functions of arrays)
 
@@ -302,12 +323,14 @@ class Renderer:
         self._collections = {}
 
     # geometry ------------------------------------------------------------------------------
-    def polygons(self, x: np.ndarray, camera: Camera):
+    def polygons(self, x: np.ndarray, camera: Camera, pose=None):
         """Depth-sorted 2D polygons and RGBA colours of one frame seen by ``camera``.
 
         Parameters
         ----------
         x : (N, 3) bead positions [m]
+        pose : ``(X, R)`` of a moving body (its reference point [m] and rotation, body to
+            lab), or ``None`` for the fixed body at the origin
 
         Returns
         -------
@@ -320,7 +343,11 @@ class Renderer:
         groups.append((quads, qn, self.tube_rgb, 1.0))
         groups.append((caps, cn, self.tube_rgb, 1.0))
         if len(self._body):
-            groups.append((self._body, self._body_n, self.body_rgb, self.body_alpha))
+            body, bn = self._body, self._body_n
+            if pose is not None:
+                X, R = pose
+                body, bn = body @ R.T + X, bn @ R.T
+            groups.append((body, bn, self.body_rgb, self.body_alpha))
         polys, depth, rgba, lw = [], [], [], []
         for P, n, rgb, alpha in groups:
             front = n @ toward > 0.0
@@ -341,11 +368,12 @@ class Renderer:
         self._linewidths = np.concatenate(lw)[order]
         return [polys[i] for i in order], np.concatenate(rgba)[order]
 
-    def draw(self, ax, x: np.ndarray, camera: Camera):
-        """Draw the frame ``x`` (N, 3) [m] into ``ax`` as seen by ``camera``; returns the collection."""
+    def draw(self, ax, x: np.ndarray, camera: Camera, pose=None):
+        """Draw the frame ``x`` (N, 3) [m] into ``ax`` as seen by ``camera`` (a moving body at
+        ``pose``, :meth:`polygons`); returns the collection."""
         from matplotlib.collections import PolyCollection
 
-        polys, rgba = self.polygons(x, camera)
+        polys, rgba = self.polygons(x, camera, pose)
         coll = self._collections.get(id(ax))
         if coll is None:
             coll = PolyCollection(polys, facecolors=rgba, edgecolors=rgba,
@@ -360,7 +388,8 @@ class Renderer:
         return coll
 
 
-def view_limits(frames: np.ndarray, scene: Scene, cameras=CAMERAS, margin: float = 0.05):
+def view_limits(frames: np.ndarray, scene: Scene, cameras=CAMERAS, margin: float = 0.05,
+                poses=None):
     """Common axes limits for every frame and every camera (same scale everywhere).
 
     Parameters
@@ -372,9 +401,12 @@ def view_limits(frames: np.ndarray, scene: Scene, cameras=CAMERAS, margin: float
     -------
     (u_min, u_max), (z_min, z_max) : horizontal and vertical limits [m], the horizontal range
     centred on the body axis and wide enough for all cameras. The body is shown down from its
-    top only as far as the filament climbs (at least one body radius above the cap).
+    top only as far as the filament climbs (at least one body radius above the cap). A moving
+    body (``poses``, :func:`body_poses` of the frames shown) is kept in view whole.
     """
     frames = np.asarray(frames, float)
+    if poses is not None:
+        frames = np.concatenate([frames.reshape(-1, 3), body_outline(scene, poses)])[None]
     a = scene.tube_radius
     half = max(scene.body_radius, 1e-12)
     for cam in cameras:
@@ -382,7 +414,7 @@ def view_limits(frames: np.ndarray, scene: Scene, cameras=CAMERAS, margin: float
         half = max(half, float(np.abs(u).max()) + a)
     zmin = float(frames[..., 2].min()) - a
     zmax = float(frames[..., 2].max()) + a
-    if scene.has_body:
+    if scene.has_body and poses is None:
         # the body is shown up to where the filament climbs, at least one radius above the
         # cap, never past its top; the filament itself is never cut
         body_top = min(max(zmax, 2.0 * scene.body_radius), scene.body_radius + scene.body_length)

@@ -83,6 +83,7 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     from flagwrap.plotting.render import (
         CAMERAS,
         Renderer,
+        body_poses,
         nice_scale_bar,
         scene_of,
         style_view,
@@ -95,7 +96,9 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     turns = ds["turns"].values
     om = ds["omega"].values
     scene = scene_of(ds)
-    ulim, zlim = view_limits(X[idx], scene)
+    poses = body_poses(ds)  # a free swimmer's body, drawn where it is
+    ulim, zlim = view_limits(X[idx], scene, poses=None if poses is None else
+                             (poses[0][idx], poses[1][idx]))
     aspect = (zlim[1] - zlim[0]) / (ulim[1] - ulim[0])
     ncol = len(idx)
     fig, axes = plt.subplots(2, ncol, figsize=(panel_width * ncol + 0.4, 2 * panel_width * aspect + 0.8),
@@ -105,7 +108,7 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     for j, i in enumerate(idx):
         for r, cam in enumerate(CAMERAS):
             ax = axes[r, j]
-            rend.draw(ax, X[i], cam)
+            rend.draw(ax, X[i], cam, None if poses is None else (poses[0][i], poses[1][i]))
             sense = "CW" if om[i] < 0 else ("CCW" if om[i] > 0 else "stop")
             style_view(ax, ulim, zlim,
                        title=f"$t/T$ = {turns[i]:.2f} ({sense})" if r == 0 else None,
