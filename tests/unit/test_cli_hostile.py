@@ -67,6 +67,15 @@ def make_world(d: Path) -> Path:
     (d / "selfrange.toml").write_text(tiny_toml().replace("[contact]", "[contact]\nself_contact = true\nself_range = 500.0")
                                       if "[contact]" in tiny_toml() else
                                       tiny_toml() + "\n[contact]\nself_contact = true\nself_range = 500.0\n")
+    # issue 19: the bacterium
+    (d / "overlap.toml").write_text(tiny_toml() + "\n[initial]\nperturbation = 0.2\nseed = 4\n")
+    swim = "\n[body]\nsurface = 'no-slip'\nmotion = 'free'\n"
+    (d / "blobgap.toml").write_text(tiny_toml() + swim + "blob_radius = 0.002\n")
+    (d / "stall.toml").write_text(tiny_toml().replace("machin = 100", "machin = 100\nkind = 'torque'\n"
+                                                      "stall_torque = -1e-3"))
+    (d / "nomotor.toml").write_text(tiny_toml().replace('"ccw"', '"stop"').replace('"cw"', '"stop"')
+                                    + swim)
+    (d / "freeclear.toml").write_text(tiny_toml() + "\n[body]\nmotion = 'free'\n")
     (d / "big.toml").write_text("name = 'big'\n[grid]\npsi_deg = [" + ", ".join(str(30 + 0.01 * i) for i in range(1000))
                                 + "]\nturns = [" + ", ".join(str(1.5 + 0.001 * i) for i in range(1000)) + "]\nmachin = 100.0\n")
     return d
@@ -134,6 +143,13 @@ HOSTILE = [
     (["stability", "{d}/big.toml", "--sweep", "--direction", "ccw"], "--sweep"),
     (["stability", "{d}/big.toml", "--sweep", "--workers", "0"], "--workers"),
     (["stability", "{d}/hookneg.toml"], "joint.hook_length"),
+    # issue 19: the bacterium
+    (["run", "{d}/overlap.toml", "-o", "{d}/new.nc", "--quiet"], "body overlaps the filament"),
+    (["run", "{d}/blobgap.toml", "-o", "{d}/new.nc", "--quiet"], "body.blob_radius"),
+    (["run", "{d}/stall.toml", "-o", "{d}/new.nc", "--quiet"], "motor.stall_torque must be > 0"),
+    (["run", "{d}/nomotor.toml", "-o", "{d}/new.nc", "--quiet"], "needs a motor that turns"),
+    (["run", "{d}/freeclear.toml", "-o", "{d}/new.nc", "--quiet"], "needs body.surface = 'no-slip'"),
+    (["stability", "{d}/stall.toml"], "motor.stall_torque"),
 ]
 
 
