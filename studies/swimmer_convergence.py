@@ -148,6 +148,31 @@ def table(rows, first_cols, h):
     return out
 
 
+def cylinder_rows(make_body, H, a, RH):
+    """The rigid swimmer on ``make_body(spacing)`` (blob radius half the spacing) at every
+    spacing; with ``RH`` also the swimmer without body-helix interaction."""
+    from flagwrap.body.multiblob import nearest_spacing, resistance_matrix
+
+    rows = []
+    for sp in SPACINGS:
+        body = make_body(sp)
+        r = solve(body, 0.5 * sp, H, a)
+        r.update(n=len(body), sp=sp, ratio=nearest_spacing(body) / (0.5 * sp))
+        if RH is not None:
+            ref = no_hi(resistance_matrix(body, 0.5 * sp), RH)
+            r.update(noU=ref["U"], noOm=ref["Om"])
+        rows.append(r)
+    return rows
+
+
+def report_default(rows, cyl, how: str) -> None:
+    d = next(r for r in rows if r["sp"] == DEFAULT_SPACING)
+    print(f"Default spacing {DEFAULT_SPACING:g} L ({d['n']} blobs){how} against the "
+          "extrapolation (observed order / integer order): "
+          + ", ".join(f"{name} {(d[k] - cyl[k][1]) / cyl[k][1]:+.1e} / "
+                      f"{(d[k] - cyl[k][2]) / cyl[k][2]:+.1e}" for k, name in KEYS) + "\n")
+
+
 def main():
     from flagwrap.body.multiblob import (
         capped_cylinder_blobs,
@@ -189,38 +214,17 @@ def main():
     # 2. the paper's capped cylinder
     print(f"## Capped cylinder, radius {R_S:g} L, cylinder {CYL_LENGTH:g} L, "
           "blob radius = spacing / 2\n")
-    rows = []
-    for sp in SPACINGS:
-        body = capped_cylinder_blobs(R_S, CYL_LENGTH, sp)
-        r = solve(body, 0.5 * sp, H, a)
-        ref = no_hi(resistance_matrix(body, 0.5 * sp), RH)
-        r.update(n=len(body), sp=sp, ratio=nearest_spacing(body) / (0.5 * sp),
-                 noU=ref["U"], noOm=ref["Om"])
-        rows.append(r)
+    rows = cylinder_rows(lambda sp: capped_cylinder_blobs(R_S, CYL_LENGTH, sp), H, a, RH)
     cols = [("spacing", lambda r: f"{r['sp']:g}"), ("blobs", lambda r: f"{r['n']}"),
             ("widest gap / a_b", lambda r: f"{r['ratio']:.2f}")]
-    cyl = table(rows, cols, [r["sp"] for r in rows])
-    d = next(r for r in rows if r["sp"] == DEFAULT_SPACING)
-    print(f"Default spacing {DEFAULT_SPACING:g} L ({d['n']} blobs) against the extrapolation "
-          "(observed order / integer order): "
-          + ", ".join(f"{name} {(d[k] - cyl[k][1]) / cyl[k][1]:+.1e} / "
-                      f"{(d[k] - cyl[k][2]) / cyl[k][2]:+.1e}" for k, name in KEYS) + "\n")
+    report_default(rows, table(rows, cols, [r["sp"] for r in rows]), "")
     # 2b. the same, blobs inset by BLOB_INSET a_b (what the simulator's cell_body_blobs does)
     from flagwrap.body.multiblob import BLOB_INSET, inset_capped_cylinder_blobs
 
     print(f"## Capped cylinder, blobs inset by {BLOB_INSET:g} a_b (the simulator's cell body)\n")
-    rows_in = []
-    for sp in SPACINGS:
-        body = inset_capped_cylinder_blobs(R_S, CYL_LENGTH, sp, 0.5 * sp)
-        r = solve(body, 0.5 * sp, H, a)
-        r.update(n=len(body), sp=sp, ratio=nearest_spacing(body) / (0.5 * sp))
-        rows_in.append(r)
-    cyl_in = table(rows_in, cols, [r["sp"] for r in rows_in])
-    d = next(r for r in rows_in if r["sp"] == DEFAULT_SPACING)
-    print(f"Default spacing {DEFAULT_SPACING:g} L ({d['n']} blobs), inset, against the "
-          "extrapolation (observed order / integer order): "
-          + ", ".join(f"{name} {(d[k] - cyl_in[k][1]) / cyl_in[k][1]:+.1e} / "
-                      f"{(d[k] - cyl_in[k][2]) / cyl_in[k][2]:+.1e}" for k, name in KEYS) + "\n")
+    rows_in = cylinder_rows(lambda sp: inset_capped_cylinder_blobs(R_S, CYL_LENGTH, sp, 0.5 * sp),
+                            H, a, None)
+    report_default(rows_in, table(rows_in, cols, [r["sp"] for r in rows_in]), ", inset,")
     print("No body-helix interaction (each body's own R):\n")
     print("| spacing | U.a, no HI | U.a / no HI | Omega_z, no HI | Omega_z / no HI |")
     print("|---:|---:|---:|---:|---:|")

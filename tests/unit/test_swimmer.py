@@ -300,3 +300,25 @@ def test_fixed_no_slip_body_is_wired_and_keeps_the_paper_keys():
     assert ns.to_dict(for_hash=True)["body"]["surface"] == "no-slip"
     with pytest.raises(UserInputError, match="numerics.frame = 'rotating'"):
         ns.replace(numerics=Numerics(frame="rotating"))
+
+
+def test_swimmer_frame_jacobian_is_the_derivative_of_its_velocity(swimmer, rng):
+    # the linear-stability Jacobian (A dG + (dA/dx)[G] + exact rotation terms) against central
+    # differences of the frame's velocity: 1e-5 of its largest entry (the differences' own
+    # error at steps 1e-4 b on the stiff bonds is ~1e-7)
+    from flagwrap.system.swimmer import SwimmerFrame
+
+    s = swimmer
+    fr = SwimmerFrame(s, -1.0)
+    y, _ = perturbed_state(s, rng, amp=0.003)
+    z = y[:fr.n]
+    base = s.frames0
+    J = fr.jacobian(z, base)
+    h = 1e-4 * s.bond
+    fd = np.empty_like(J)
+    for k in range(fr.n):
+        zp, zm = z.copy(), z.copy()
+        zp[k] += h
+        zm[k] -= h
+        fd[:, k] = (fr.velocity(zp, base)[0] - fr.velocity(zm, base)[0]) / (2 * h)
+    assert np.abs(J - fd).max() < 1e-5 * np.abs(fd).max()

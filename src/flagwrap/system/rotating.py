@@ -102,10 +102,14 @@ class RotatingFrame:
         check_rotating_frame(system, blob_body=blob_body)
         if system.i_phi != system.ny - 1:
             raise ValueError("RotatingFrame: the motor angle must be the last unknown")
+        self._setup(system, omega, system.ny - 1)
+
+    def _setup(self, system, omega: float, n: int) -> None:
+        """The frame of ``system`` turning at ``omega``, over its first ``n`` unknowns."""
         self.system = system
         self.omega = float(omega)
         self.axis = np.asarray(system.joint.axis, float)
-        self.n = system.ny - 1
+        self.n = n
         self.n3 = 3 * system.nb
         self._A = cross_matrix(self.axis)
 

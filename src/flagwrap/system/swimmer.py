@@ -47,8 +47,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from flagwrap.system.layout import DofLayout
-from flagwrap.system.rotating import (RotatingFrame, check_rotating_frame, cross_matrix,
-                                      subtract_rotation)
+from flagwrap.system.rotating import RotatingFrame, check_rotating_frame, subtract_rotation
 
 
 def quaternion_matrix(q) -> np.ndarray:
@@ -127,6 +126,10 @@ class SwimmerSystem:
 
     def interaction_jacobian_coo(self, y, which: str = "all"):
         return self.inner.interaction_jacobian_coo(y[:self.n_in], which)
+
+    def force_jacobian(self, y, base, G0=None, delta=None) -> np.ndarray:
+        """``dG/dy`` over the filament's unknowns (n_in, n_in)."""
+        return self.inner.force_jacobian(y[:self.n_in], base, G0, delta)
 
     # mobility ------------------------------------------------------------------------------
     def _geometry(self, y):
@@ -253,7 +256,7 @@ class SwimmerW:
 
         n = system.n_in
         inner = system.inner
-        J = inner.force_jacobian(y[:n], base, G0[:n])
+        J = system.force_jacobian(y, base, G0[:n])
         motor = inner.drive.free and inner.motor_jacobian(y[:n], base, omega)
         if motor:  # a torque motor: the force Jacobian's motor column, the motor's row
             J[:, inner.i_phi] = motor[0]
@@ -276,11 +279,11 @@ class SwimmerW:
         return out
 
 
-class SwimmerFrame:
+class SwimmerFrame(RotatingFrame):
     """The free swimmer in the frame turning with its motor relative to the body, for linear
-    stability (:mod:`flagwrap.stability`): the interface of
-    :class:`~flagwrap.system.rotating.RotatingFrame`, whose rotation terms and Jacobian
-    assembly it reuses.
+    stability (:mod:`flagwrap.stability`): a
+    :class:`~flagwrap.system.rotating.RotatingFrame` whose rotation terms and Jacobian
+    assembly it inherits, with the swimmer's mobility.
 
     Unknowns ``z``: the filament's (positions and twists, no motor angle) in this frame. A
     steady state here is a filament turning rigidly with the motor while the body turns and
@@ -291,12 +294,7 @@ class SwimmerFrame:
 
     def __init__(self, swimmer, omega: float):
         check_rotating_frame(swimmer.inner)
-        self.system = swimmer
-        self.omega = float(omega)
-        self.axis = np.asarray(swimmer.joint.axis, float)
-        self.n = swimmer.n_in - 1
-        self.n3 = 3 * swimmer.nb
-        self._A = cross_matrix(self.axis)
+        self._setup(swimmer, omega, swimmer.n_in - 1)
 
     def full(self, z) -> np.ndarray:
         s = self.system
@@ -304,9 +302,6 @@ class SwimmerFrame:
         y[:self.n] = z
         y[s.sl_q.start] = 1.0
         return y
-
-    def scale(self, machin) -> float:
-        return 1.0 if machin is None else self.system.machin / float(machin)
 
     def velocity(self, z, base, machin=None):
         s = self.system
@@ -332,9 +327,6 @@ class SwimmerFrame:
             yp[k] = y[k]
             J[:, k] += (vp - vm) / (2.0 * h)
         return J
-
-    # the frame's Jacobian: its force Jacobian, this mobility part, its exact rotation terms
-    jacobian = RotatingFrame.jacobian
 
 
 def make_swimmer(config):
