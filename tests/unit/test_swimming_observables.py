@@ -129,3 +129,22 @@ def test_the_moving_body_is_drawn_and_exported_where_it_is(tmp_path):
     pvd = export_vtk(ds, tmp_path / "vtk", with_forces=False)
     files = sorted(p.name for p in pvd.parent.glob("body_*.vtp"))
     assert len(files) == 2
+
+
+def test_analyze_draws_a_swimmer_and_refuses_a_fixed_body(tmp_path, tiny_run):
+    import dataclasses
+
+    from conftest import make_config, paper_filament
+    from flagwrap.cli.main import main
+    from flagwrap.io.runfile import write_run
+    from flagwrap.simulation import simulate
+
+    cfg = make_config(protocol=(("ccw", 0.1), ("cw", 0.1)), filament=paper_filament(n_beads=21))
+    cfg = cfg.replace(body=dataclasses.replace(cfg.body, surface="no-slip", motion="free",
+                                               blob_spacing=0.025))
+    path = write_run(simulate(cfg), tmp_path / "swim.nc")
+    assert main(["analyze", str(path), "--no-write", "--figure", str(tmp_path / "s.png")]) == 0
+    assert (tmp_path / "s.png").stat().st_size > 10_000
+    before = tiny_run.read_bytes()
+    assert main(["analyze", str(tiny_run), "--figure", str(tmp_path / "t.png")]) == 2
+    assert tiny_run.read_bytes() == before and not (tmp_path / "t.png").exists()

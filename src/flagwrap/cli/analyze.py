@@ -19,6 +19,8 @@ def add_arguments(p):
     p.add_argument("runs", nargs="+", metavar="RUN.nc", help="run file(s) written by `flagwrap run`")
     p.add_argument("--json", action="store_true", help="print one JSON object per run instead of a table")
     p.add_argument("--no-write", action="store_true", help="do not store the results in the run file")
+    p.add_argument("--figure", metavar="PNG", help="a free swimmer's run: draw its displacement, "
+                   "motor and body rates and free-end height against time (one run only)")
     g = p.add_argument_group("criteria (defaults: docs/analysis.md)")
     g.add_argument("--threshold", type=float, default=0.15, help="buckling rise of the free end [L] (0.15)")
     g.add_argument("--hold-turns", type=float, default=1.0, help="rise must persist [turns] (1)")
@@ -59,6 +61,14 @@ def run(args) -> int:
     from flagwrap.analysis.buckling import BucklingAnalysis, FinalState, WaitingTime
     from flagwrap.analysis.runfile_attrs import analyze_run_file, jsonable
 
+    figure = None
+    if args.figure is not None:
+        from flagwrap.errors import UserInputError
+        from flagwrap.io.outputs import check_output_file
+
+        if len(args.runs) != 1:
+            raise UserInputError(f"--figure draws one run; got {len(args.runs)}")
+        figure = check_output_file(args.figure, "--figure", suffixes=(".png", ".pdf"))
     for path in args.runs:
         analysis = BucklingAnalysis(
             WaitingTime(threshold=args.threshold, hold_turns=args.hold_turns,
@@ -67,7 +77,17 @@ def run(args) -> int:
                        min_contact_fraction=args.min_contact_fraction,
                        contact_distance=args.contact_distance, final_turns=args.final_turns),
         )
+        if figure is not None:  # refused before anything is written
+            from flagwrap.io.runfile import read_run
+
+            if "body_position" not in read_run(path).variables:
+                raise UserInputError(f"--figure needs a free swimmer's run (body.motion = 'free'); "
+                                     f"{path} has a fixed body")
         res = analyze_run_file(path, analysis, write=not args.no_write)
+        if figure is not None:
+            from flagwrap.plotting.swimming import plot_swimming
+
+            plot_swimming(read_run(path), figure)
         if args.json:
             print(json.dumps(jsonable(res), sort_keys=True))
             continue
