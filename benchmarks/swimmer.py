@@ -13,6 +13,11 @@ Measured in one process, on one core (BLAS limited to one thread), each case tim
 
 Prints steps, rejected steps, seconds and ``ratio`` = seconds / the reference's seconds.
 The issue's target: one turn of the free swimmer under 10x one turn of Fig. 4(a).
+
+``--memory``: the blob solvers instead (:mod:`flagwrap.body.solver`). For the paper's body at
+spacings giving ~500 to ~4000 blobs, each solver's peak memory (tracemalloc, which sees
+numpy's buffers) over building it and one mobility product for the 61-bead filament
+(``FixedBodyMobility.apply``), the seconds for each, and the CG iterations.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import argparse
 import dataclasses
 import time
 
+import numpy as np
 from threadpoolctl import threadpool_limits
 
 from flagwrap.cases import get_case
@@ -41,10 +47,45 @@ def cases(turns: float):
             ("fig4a, free no-slip", free), ("S. putrefaciens, free no-slip, hook", sp)]
 
 
+def memory_table(spacings=(0.038, 0.026, 0.018, 0.0127), solvers=("direct", "krylov")):
+    import tracemalloc
+
+    from flagwrap.body.multiblob import inset_capped_cylinder_blobs
+    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.system.rod_system import RodSystem
+
+    cfg = get_case("fig4a")
+    x = RodSystem(cfg).x0[2:]
+    a = cfg.filament.bead_radius / cfg.filament.length
+    F = np.random.default_rng(0).standard_normal(x.shape)
+    print("| blobs | solver | peak memory [MB] | build [s] | one product [s] | CG iterations |")
+    print("|---:|---|---:|---:|---:|---:|")
+    for sp in spacings:
+        blobs = inset_capped_cylinder_blobs(0.125, 0.625, sp, 0.5 * sp)
+        for solver in solvers:
+            tracemalloc.start()
+            t0 = time.perf_counter()
+            mob = FixedBodyMobility(a, blobs, 0.5 * sp, solver=solver)
+            t1 = time.perf_counter()
+            mob.apply(x, F)
+            t2 = time.perf_counter()
+            peak = tracemalloc.get_traced_memory()[1] / 1e6
+            tracemalloc.stop()
+            its = getattr(mob._solver, "iterations", None)
+            print(f"| {len(blobs)} | {solver} | {peak:.0f} | {t1 - t0:.2f} | {t2 - t1:.3f} | "
+                  f"{its[-1] if its else '-'} |", flush=True)
+            del mob
+
+
 def main(argv=None):
     p = argparse.ArgumentParser()
     p.add_argument("--turns", type=float, default=1.0)
+    p.add_argument("--memory", action="store_true", help="the blob solvers' memory table")
     args = p.parse_args(argv)
+    if args.memory:
+        with threadpool_limits(limits=1):
+            memory_table()
+        return
     ref = None
     with threadpool_limits(limits=1):
         for name, cfg in cases(args.turns):

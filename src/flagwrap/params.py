@@ -34,6 +34,9 @@ MAX_BODY_OVER_LENGTH = 10.0
 #: most blobs on a no-slip body for the direct (dense Cholesky) solve: 4000 blobs are a
 #: 12000^2 matrix, 1.15 GB, factorised once in ~10 s on one core
 MAX_BLOBS = 4000
+#: most blobs for the Krylov solve (O(n) memory, O(n^2) time per product: 20000 blobs are
+#: ~4e8 pair terms per product, seconds)
+MAX_BLOBS_KRYLOV = 20000
 
 
 def _finite(name: str, value) -> float:
@@ -289,7 +292,9 @@ class CellBody:
     a no-slip surface, since a transparent body has no drag, and a motor that turns).
     ``blob_spacing`` [m] defaults to ``R_cell / 3`` and ``blob_radius`` [m] to half the
     spacing (Usabiaga et al. 2016 use blobs about half their spacing; docs/bacterium.md
-    measures the convergence in both).
+    measures the convergence in both). ``solver``: how the blob matrix is solved, "direct"
+    (Cholesky once, O(n^2) memory), "krylov" (conjugate gradients, O(n) memory) or "auto"
+    (direct up to 1500 blobs; :mod:`flagwrap.body.solver`).
     """
 
     radius: float | None = None
@@ -300,12 +305,13 @@ class CellBody:
     motion: str = "fixed"
     blob_spacing: float | None = None
     blob_radius: float | None = None
+    solver: str = "auto"
 
     DEFAULT_RADIUS_RATIO = 0.6
     SURFACES = ("transparent", "no-slip")
     MOTIONS = ("fixed", "free")
     #: keys added after results were stored, left out of result keys at these defaults
-    HASH_OMIT_DEFAULTS = {"surface": "transparent", "motion": "fixed"}
+    HASH_OMIT_DEFAULTS = {"surface": "transparent", "motion": "fixed", "solver": "auto"}
 
     def __post_init__(self):
         if self.radius is not None:
@@ -331,6 +337,10 @@ class CellBody:
         if self.motion not in self.MOTIONS:
             raise UserInputError(f"body.motion must be one of {', '.join(self.MOTIONS)}, "
                                  f"got {self.motion!r}")
+        from flagwrap.body.solver import KINDS
+
+        if self.solver not in KINDS:
+            raise UserInputError(f"body.solver must be one of {', '.join(KINDS)}, got {self.solver!r}")
         for key in ("blob_spacing", "blob_radius"):
             if getattr(self, key) is not None:
                 _positive(f"body.{key}", getattr(self, key), "m")
@@ -864,11 +874,16 @@ class Config:
             raise UserInputError(f"body.blob_spacing = {sp:g} m must be smaller than the body "
                                  f"radius {rc:g} m")
         blobs, _ = cell_body_blobs(self)
-        if len(blobs) > MAX_BLOBS:
+        from flagwrap.body.solver import AUTO_DIRECT_MAX
+
+        direct = b.solver == "direct" or (b.solver == "auto" and len(blobs) <= AUTO_DIRECT_MAX)
+        most = MAX_BLOBS if direct else MAX_BLOBS_KRYLOV
+        if len(blobs) > most:
             raise UserInputError(
                 f"body.blob_spacing = {sp:g} m puts {len(blobs)} blobs on the body, more than "
-                f"{MAX_BLOBS} (the direct solve's limit); use a spacing >= "
-                f"{sp * math.sqrt(len(blobs) / MAX_BLOBS):.3g} m")
+                f"{most} (the {'direct' if direct else 'Krylov'} solve's limit); use a spacing >= "
+                f"{sp * math.sqrt(len(blobs) / most):.3g} m"
+                + (" or body.solver = 'krylov'" if direct else ""))
         check_spacing(blobs * self.filament.length, b.resolved_blob_radius(R),
                       what="body.blob_radius [m]")
         if self.numerics.frame != "lab":

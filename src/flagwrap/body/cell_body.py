@@ -82,4 +82,4 @@ def body_mobility(config, radius: float):
     from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
 
     blobs, radii = cell_body_blobs(config)
-    return FixedBodyMobility(radius, blobs, radii)
+    return FixedBodyMobility(radius, blobs, radii, solver=config.body.solver)

@@ -132,7 +132,8 @@ class FixedBodyMobility:
     The body's blobs carry forces ``lambda`` that hold its surface still. A bead force ``F``
     moves the blobs at ``M_bf F``, so ``M_bb lambda = -M_bf F``, and the beads move at
     ``(M_ff - M_fb M_bb^-1 M_bf) F``. That Schur complement is the mobility here. ``M_bb`` is
-    factorised once, since the body does not move. It is symmetric and positive definite, and
+    factorised once, since the body does not move (``solver = "direct"``), or solved by
+    conjugate gradients in O(n) memory (``"krylov"``; :mod:`flagwrap.body.solver`). It is symmetric and positive definite, and
     smaller than ``M_ff``: the surface screens the flow. Viscosity 1; the bead radius is one
     number, the blobs' radii per blob. It has ``matrix`` and ``apply`` of the mobility
     interface. ``apply_single`` is ``apply``, and ``near_field_blocks`` (for the banded
@@ -145,9 +146,8 @@ class FixedBodyMobility:
     backend = "direct+fixed-body"
     axisymmetric = False
 
-    def __init__(self, radius: float, blobs, blob_radii):
-        import scipy.linalg as sl
-
+    def __init__(self, radius: float, blobs, blob_radii, solver: str = "direct"):
+        from flagwrap.body.solver import make_blob_solver
         from flagwrap.hydrodynamics.mobility import RPYMobility
 
         self.radius = float(radius)
@@ -156,8 +156,7 @@ class FixedBodyMobility:
         self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
                                                dtype=np.float64)
         self._free = RPYMobility(self.radius)
-        Mbb = PolydisperseRPY(self.blob_radii).matrix(self.blobs)
-        self._chol = sl.cho_factor(Mbb, lower=True, check_finite=False)
+        self._solver = make_blob_solver(solver, self.blobs, self.blob_radii)
 
     def _cross(self, x):
         out = np.empty((3 * len(x), 3 * len(self.blobs)))
@@ -167,12 +166,9 @@ class FixedBodyMobility:
 
     def screening(self, x) -> np.ndarray:
         """``M_fb M_bb^-1 M_bf`` (3n, 3n): what the body takes off the free mobility."""
-        import scipy.linalg as sl
+        from flagwrap.body.solver import screening_matrix
 
-        C = self._cross(x)
-        L = self._chol[0]
-        Y = sl.solve_triangular(L, C.T, lower=True, check_finite=False)
-        return Y.T @ Y
+        return screening_matrix(self._solver, self._cross(x))
 
     def matrix(self, x, out=None):
         M = self._free.matrix(x, out=out)
@@ -183,11 +179,9 @@ class FixedBodyMobility:
         return self._free.near_field_blocks(x, width)
 
     def apply(self, x, F):
-        import scipy.linalg as sl
-
         F = np.ascontiguousarray(F, dtype=np.float64)
         C = self._cross(x)
-        lam = sl.cho_solve(self._chol, C.T @ F.ravel(), check_finite=False)
+        lam = self._solver.solve(C.T @ F.ravel())
         return self._free.apply(x, F) - (C @ lam).reshape(-1, 3)
 
     apply_single = apply

@@ -75,9 +75,9 @@ class SwimmerSystem:
     coordinates (core units). Everything not overridden here is the filament system's.
     """
 
-    def __init__(self, system, blobs, blob_radii):
+    def __init__(self, system, blobs, blob_radii, solver: str = "direct"):
         from flagwrap.body.multiblob import geometric_matrix
-        from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY
+        from flagwrap.body.solver import make_blob_solver
 
         if not system.mobility.long_range or getattr(system.mobility, "backend", "") != "direct":
             raise ValueError("SwimmerSystem needs the filament's free-space direct RPY mobility")
@@ -87,10 +87,9 @@ class SwimmerSystem:
         self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
         self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
                                                dtype=np.float64)
-        Mbb = PolydisperseRPY(self.blob_radii).matrix(self.blobs)
-        self._chol = sla.cho_factor(Mbb, lower=True, check_finite=False)
+        self._solver = make_blob_solver(solver, self.blobs, self.blob_radii)
         self.K = geometric_matrix(self.blobs)
-        self._MinvK = sla.cho_solve(self._chol, self.K, check_finite=False)  # (3 n_blob, 6)
+        self._MinvK = self._solver.solve(self.K)  # (3 n_blob, 6)
         #: the body's own mobility (K^T M_bb^-1 K)^-1, viscosity 1, about the reference point
         self.body_mobility = np.linalg.inv(0.5 * (self.K.T @ self._MinvK + (self.K.T @ self._MinvK).T))
         s = system
@@ -156,7 +155,7 @@ class SwimmerSystem:
         xf, t, C = self._geometry(y)
         F = np.asarray(G[s.sl_x]).reshape(-1, 3)
         tau = np.asarray(G[s.sl_th])
-        w = sla.cho_solve(self._chol, C.T @ F.ravel(), check_finite=False)
+        w = self._solver.solve(C.T @ F.ravel())
         V = self.body_mobility @ (self.K.T @ w - self._load(xf, t, F, tau))
         lam = self._MinvK @ V - w
         v = s.mobility.apply(xf, F) + (C @ lam).reshape(-1, 3)
@@ -199,8 +198,9 @@ class SwimmerSystem:
         A = np.zeros((self.n_in, self.n_in))
         A[:n3, :n3] = s.mobility.matrix(xf)
         if screening:
-            Y = sla.solve_triangular(self._chol[0], C.T, lower=True, check_finite=False)
-            A[:n3, :n3] -= Y.T @ Y
+            from flagwrap.body.solver import screening_matrix
+
+            A[:n3, :n3] -= screening_matrix(self._solver, C)
         idx = np.arange(n3, n3 + s.ne)
         A[idx, idx] = s.twist_mobility * s.machin
         D = np.zeros((6, self.n_in))
@@ -338,6 +338,6 @@ def make_swimmer(config):
     fil = config.filament
     inner = RodSystem(config, mobility=RPYMobility(fil.bead_radius / fil.length))
     blobs, radii = cell_body_blobs(config)
-    return SwimmerSystem(inner, blobs, radii)
+    return SwimmerSystem(inner, blobs, radii, solver=config.body.solver)
 
 

@@ -1,0 +1,129 @@
+"""Solves with a fixed blob body's RPY matrix ``M_bb`` (``[body] solver``).
+
+Every product of the no-slip body's mobilities (:class:`~flagwrap.hydrodynamics.polydisperse.
+FixedBodyMobility`, :class:`~flagwrap.system.swimmer.SwimmerSystem`) needs ``M_bb^-1 r``.
+The blobs do not move in the body's frame, so ``M_bb`` is the same for a whole run.
+
+* :class:`DirectBlobSolver`: its Cholesky factor, computed once: O(n^2) memory (a 4000-blob
+  body is a 12000^2 matrix, 1.15 GB), each solve O(n^2).
+* :class:`KrylovBlobSolver`: conjugate gradients (``M_bb`` is symmetric positive definite)
+  with the matrix applied on the fly (the RPY sum, O(n) memory) and a block-Jacobi
+  preconditioner: the blobs cut into spatial clusters of about ``block`` blobs (a k-d
+  ordering), each cluster's own RPY block factorised. O(n block) memory, each solve a few tens
+  of O(n^2) products; stops at the relative residual ``rtol``.
+
+``make_blob_solver(kind, ...)``: ``"auto"`` is direct up to ``AUTO_DIRECT_MAX`` blobs.
+Measured (benchmarks/swimmer.py): memory and time per solve against the number of blobs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+#: most blobs for which "auto" takes the direct solver (a 1500-blob factor is 162 MB)
+AUTO_DIRECT_MAX = 1500
+KINDS = ("auto", "direct", "krylov")
+
+
+class DirectBlobSolver:
+    """Cholesky factor of ``M_bb``, computed once."""
+
+    kind = "direct"
+
+    def __init__(self, blobs: np.ndarray, radii: np.ndarray):
+        from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY
+
+        Mbb = PolydisperseRPY(radii).matrix(blobs)
+        self._chol = sla.cho_factor(Mbb, lower=True, check_finite=False)
+
+    def solve(self, r: np.ndarray) -> np.ndarray:
+        """``M_bb^-1 r`` (r: (3n,) or (3n, k))."""
+        return sla.cho_solve(self._chol, r, check_finite=False)
+
+    def half_solve(self, C: np.ndarray) -> np.ndarray:
+        """``L^-1 C^T`` (3n, m) with ``M_bb = L L^T``: ``C M_bb^-1 C^T = Y^T Y``."""
+        return sla.solve_triangular(self._chol[0], C.T, lower=True, check_finite=False)
+
+
+class KrylovBlobSolver:
+    """Preconditioned conjugate gradients on ``M_bb`` (module docstring)."""
+
+    kind = "krylov"
+
+    def __init__(self, blobs: np.ndarray, radii: np.ndarray, rtol: float = 1e-10,
+                 block: int = 64, maxiter: int = 500):
+        from scipy.spatial import cKDTree
+
+        from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY
+
+        self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
+        self.radii = np.ascontiguousarray(radii, dtype=np.float64)
+        self.rtol, self.maxiter = float(rtol), int(maxiter)
+        self.iterations = []  # per solve, for the benchmarks
+        n = len(self.blobs)
+        # clusters: the leaves of a k-d tree of about `block` blobs each
+        tree = cKDTree(self.blobs, leafsize=max(1, block // 2))
+        order = np.asarray(tree.indices)
+        self._groups = [order[i:i + block] for i in range(0, n, block)]
+        self._factors = []
+        for g in self._groups:
+            Mg = PolydisperseRPY(self.radii[g]).matrix(np.ascontiguousarray(self.blobs[g]))
+            self._factors.append(sla.cho_factor(Mg, lower=True, check_finite=False))
+        self._n = 3 * n
+
+    def apply(self, v: np.ndarray) -> np.ndarray:
+        """``M_bb v``, the RPY sum (no matrix)."""
+        from flagwrap.hydrodynamics.polydisperse import rpy_apply_radii
+
+        out = np.empty((len(self.blobs), 3))
+        rpy_apply_radii(self.blobs, self.radii, np.ascontiguousarray(v.reshape(-1, 3)), out)
+        return out.ravel()
+
+    def _precondition(self, r: np.ndarray) -> np.ndarray:
+        r3 = r.reshape(-1, 3)
+        out = np.empty_like(r3)
+        for g, f in zip(self._groups, self._factors):
+            out[g] = sla.cho_solve(f, r3[g].ravel(), check_finite=False).reshape(-1, 3)
+        return out.ravel()
+
+    def _solve1(self, r: np.ndarray) -> np.ndarray:
+        import scipy.sparse.linalg as spla
+
+        A = spla.LinearOperator((self._n, self._n), matvec=self.apply, dtype=np.float64)
+        P = spla.LinearOperator((self._n, self._n), matvec=self._precondition, dtype=np.float64)
+        count = [0]
+
+        def cb(_):
+            count[0] += 1
+
+        x, info = spla.cg(A, r, rtol=self.rtol, atol=0.0, maxiter=self.maxiter, M=P, callback=cb)
+        if info != 0:
+            raise RuntimeError(f"blob solve: CG did not reach rtol {self.rtol:g} in "
+                               f"{self.maxiter} iterations")
+        self.iterations.append(count[0])
+        return x
+
+    def solve(self, r: np.ndarray) -> np.ndarray:
+        r = np.asarray(r, float)
+        if r.ndim == 1:
+            return self._solve1(r)
+        return np.column_stack([self._solve1(r[:, k]) for k in range(r.shape[1])])
+
+
+def screening_matrix(solver, C: np.ndarray) -> np.ndarray:
+    """``C M_bb^-1 C^T`` (m, m) for the cross mobility ``C = M_fb`` (m, 3n)."""
+    if isinstance(solver, DirectBlobSolver):
+        Y = solver.half_solve(C)
+        return Y.T @ Y
+    S = C @ solver.solve(np.ascontiguousarray(C.T))
+    return 0.5 * (S + S.T)
+
+
+def make_blob_solver(kind: str, blobs, radii):
+    """The solver ``kind`` ("auto", "direct", "krylov") for these blobs."""
+    if kind not in KINDS:
+        raise ValueError(f"blob solver must be one of {KINDS}, got {kind!r}")
+    if kind == "auto":
+        kind = "direct" if len(blobs) <= AUTO_DIRECT_MAX else "krylov"
+    return DirectBlobSolver(blobs, radii) if kind == "direct" else KrylovBlobSolver(blobs, radii)
