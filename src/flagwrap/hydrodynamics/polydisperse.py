@@ -133,7 +133,8 @@ class FixedBodyMobility:
     moves the blobs at ``M_bf F``, so ``M_bb lambda = -M_bf F``, and the beads move at
     ``(M_ff - M_fb M_bb^-1 M_bf) F``. That Schur complement is the mobility here. ``M_bb`` is
     factorised once, since the body does not move (``solver = "direct"``), or solved by
-    conjugate gradients in O(n) memory (``"krylov"``; :mod:`flagwrap.body.solver`). It is symmetric and positive definite, and
+    conjugate gradients in O(n) memory (``"krylov"``; :mod:`flagwrap.body.solver`). It is
+    symmetric and positive definite, and
     smaller than ``M_ff``: the surface screens the flow. Viscosity 1; the bead radius is one
     number, the blobs' radii per blob. It has ``matrix`` and ``apply`` of the mobility
     interface. ``apply_single`` is ``apply``, and ``near_field_blocks`` (for the banded
