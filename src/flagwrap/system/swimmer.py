@@ -151,6 +151,10 @@ class SwimmerSystem:
         """``(V, v_beads, lambda)``: the body's ``[U; Omega]`` (body axes, core units), the free
         beads' lab-frame velocities in body axes, and the blob forces (core units) for the
         generalized forces ``G`` (filament unknowns) at ``y``."""
+        return self._solve(y, G)[:3]
+
+    def _solve(self, y, G):
+        """:meth:`body_velocity` and the geometry it used: ``(V, v, lambda, x_free, t)``."""
         s = self.inner
         xf, t, C = self._geometry(y)
         F = np.asarray(G[s.sl_x]).reshape(-1, 3)
@@ -159,15 +163,14 @@ class SwimmerSystem:
         V = self.body_mobility @ (self.K.T @ w - self._load(xf, t, F, tau))
         lam = self._MinvK @ V - w
         v = s.mobility.apply(xf, F) + (C @ lam).reshape(-1, 3)
-        return V / s.machin, v / s.machin, lam
+        return V / s.machin, v / s.machin, lam, xf, t
 
     def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
         """``A G`` (module docstring) over the whole state: filament rows in the body frame,
         pose rows ``dX/dt = R U``, ``dq/dt = q (0, Omega) / 2``; the motor angle's row 0."""
         s = self.inner
-        V, v, _ = self.body_velocity(y, G)
+        V, v, _, xf, t = self._solve(y, G)
         U, Om = V[:3], V[3:]
-        xf, t, _ = self._geometry(y)
         out = np.zeros(self.ny)
         out[s.sl_x] = (v - U - np.cross(Om, xf)).ravel()
         out[s.sl_th] = s.twist_mobility * G[s.sl_th] - t @ Om
