@@ -71,7 +71,7 @@ def test_analyze_reports_a_free_swimmer_phase_by_phase(tmp_path):
     path = write_run(simulate(cfg), tmp_path / "swim.nc")
     res = analyze_run_file(path)
     sw = res["swimming"]
-    assert [p["direction"] for p in sw] == ["ccw", "cw"]
+    assert [p["direction"] for p in sw] == ["ccw", "cw", "final"]
     # the motor keeps its rate relative to the body; the body turns against it
     assert math.isclose(sw[0]["motor_rate_hz"], cfg.omega / (2 * math.pi), rel_tol=1e-9)
     assert sw[0]["body_rotation_hz"] > 0 > sw[1]["body_rotation_hz"]

@@ -123,7 +123,7 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
     res = {**a.summary(), **joint_summary(ds)}
     from flagwrap.observables.swimming import swimming_summary
 
-    res["swimming"] = swimming_summary(ds)
+    res["swimming"] = swimming_summary(ds, final_turns=a.final.final_turns)
     res["params"] = a.params()
     res["path"] = str(path)
     res["run_status"] = str(ds.attrs.get("status", ""))

@@ -71,9 +71,11 @@ def phase_summary(t, phi, body_position, body_orientation, t0, t1) -> dict:
                 displacement_per_turn=dX / (abs(dphi) / (2 * math.pi)) if dphi else nan)
 
 
-def swimming_summary(ds) -> list[dict]:
+def swimming_summary(ds, final_turns: float = 1.0) -> list[dict]:
     """One :func:`phase_summary` per motor phase of a free swimmer's run file (the second half
-    of each phase), with the phase's direction; an empty list for a fixed body."""
+    of each phase), with the phase's direction, then one over the run's last ``final_turns``
+    reference turns (direction "final": the settled state, e.g. the wrapped mode, without the
+    transient that a phase's second half may still hold); an empty list for a fixed body."""
     if "body_position" not in ds.variables:
         return []
     from flagwrap.io.runfile import config_of
@@ -92,4 +94,10 @@ def swimming_summary(ds) -> list[dict]:
                             ds["body_orientation"].values, 0.5 * (t0 + t1), t1)
         row.update(direction=seg.label, t0=t0, t1=t1)
         out.append(row)
+    t1 = float(t[-1])
+    t0 = max(float(t[0]), t1 - 2 * math.pi * final_turns * T)
+    row = phase_summary(t, ds["motor_angle"].values, ds["body_position"].values,
+                        ds["body_orientation"].values, t0, t1)
+    row.update(direction="final", t0=t0, t1=t1)
+    out.append(row)
     return out
