@@ -259,11 +259,18 @@ class SwimmerW:
 
         n = system.n_in
         inner = system.inner
-        J = system.force_jacobian(y, base, G0[:n])
+        import scipy.sparse as sp
+
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0[:n])
         motor = inner.drive.free and inner.motor_jacobian(y[:n], base, omega)
         if motor:  # a torque motor: the force Jacobian's motor column, the motor's row
-            J[:, inner.i_phi] = motor[0]
-        W = -gamma_h * (system.mobility_matrix(y, screening=False) @ J)
+            keep = cols != inner.i_phi
+            rows = np.concatenate([rows[keep], np.arange(n)])
+            vals = np.concatenate([vals[keep], motor[0]])
+            cols = np.concatenate([cols[keep], np.full(n, inner.i_phi)])
+        J = sp.csc_matrix((vals, (rows, cols)), shape=(n, n))  # duplicates add
+        # A J with J sparse (~20 entries a column), as (J^T A^T)^T
+        W = -gamma_h * np.asarray((J.T @ system.mobility_matrix(y, screening=False)).T)
         W[np.diag_indices(n)] += 1.0
         if motor:
             W[inner.i_phi] = -gamma_h * motor[1]
