@@ -59,7 +59,7 @@ class DenseW:
                 system._wt_buffer = WT
         w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT)
         if system.drive.free:
-            add_motor_rows(WT, system, y, base, gamma_h, omega, Mxx, mt)
+            add_motor_rows(WT, system, y, base, gamma_h, omega)
         try:
             self.lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
         except (ValueError, np.linalg.LinAlgError) as exc:
@@ -71,18 +71,16 @@ class DenseW:
         return sla.lu_solve(self.lu, rhs, check_finite=False)
 
 
-def add_motor_rows(WT, system, y, base, gamma_h, omega, Mxx, mt) -> None:
-    """A torque motor's terms of ``W = I - gamma h Mob J`` in ``WT = W^T``: the force
-    Jacobian's motor-angle column (times ``Mob``) and the motor's row
-    (:meth:`~flagwrap.system.rod_system.RodSystem.motor_jacobian`)."""
+def add_motor_rows(WT, system, y, base, gamma_h, omega) -> None:
+    """A torque motor's row of ``W = I - gamma h Mob J`` in ``WT = W^T``
+    (:meth:`~flagwrap.system.rod_system.RodSystem.motor_jacobian`); the force Jacobian's
+    motor-angle column is in ``J`` already."""
     if omega is None:
         raise ValueError("a torque motor's W needs the phase's omega")
-    col, row, _ = system.motor_jacobian(y, base, omega)
-    i, n3 = system.i_phi, 3 * system.nb
+    row = system.motor_jacobian(y, base, omega)
+    i = system.i_phi
     WT[:, i] = -gamma_h * row
     WT[i, i] += 1.0
-    WT[i, :n3] -= gamma_h * (Mxx @ col[:n3])
-    WT[i, n3:i] -= gamma_h * mt * col[n3:i]
 
 
 def preconditioner_width(system) -> int:

@@ -301,21 +301,13 @@ class RodSystem:
         return -self.clamp.generalized_force(y[self.i_phi], info.grad_x, info.grad_theta)
 
     def motor_jacobian(self, y, base, omega: float):
-        """For a torque motor: ``(dG/dphi, m dG_phi/dy, m)`` by central differences, the
-        force Jacobian's motor-angle column and the motor's row of ``Mob J`` (``m`` the
-        drive's mobility), over the unknowns the rotor couples to (the clamp's neighbours);
-        ``None`` for a speed motor, whose angle is prescribed."""
+        """For a torque motor: the motor's row of ``Mob J``, ``m dG_phi/dy`` by central
+        differences over the unknowns the rotor couples to (the clamp's neighbours), ``m`` the
+        drive's mobility; ``None`` for a speed motor, whose angle is prescribed. (The force
+        Jacobian's motor-angle column is the kernel's own: ``force_jacobian_coo``.)"""
         if not self.drive.free:
             return None
         h = self.fd_step
-        col = np.zeros(self.ny)
-        yp = np.array(y, float)
-        yp[self.i_phi] = y[self.i_phi] + h
-        Gp = self.forces(yp, base).G
-        yp[self.i_phi] = y[self.i_phi] - h
-        Gm = self.forces(yp, base).G
-        col[:] = (Gp - Gm) / (2 * h)
-        col[self.i_phi] = 0.0
         m = self.drive.mobility(omega)
         row = np.zeros(self.ny)
         near = [3 * k + c for k in range(min(3, self.nb)) for c in range(3)]
@@ -327,7 +319,7 @@ class RodSystem:
             yp[k] = y[k] - h
             gm = self.motor_force(yp, self.forces(yp, base))
             row[k] = m * (gp - gm) / (2 * h)
-        return col, row, m
+        return row
 
     def rhs(self, y, base, omega):
         info = self.forces(y, base)

@@ -262,18 +262,13 @@ class SwimmerW:
         import scipy.sparse as sp
 
         rows, cols, vals = system.force_jacobian_coo(y, base, G0[:n])
-        motor = inner.drive.free and inner.motor_jacobian(y[:n], base, omega)
-        if motor:  # a torque motor: the force Jacobian's motor column, the motor's row
-            keep = cols != inner.i_phi
-            rows = np.concatenate([rows[keep], np.arange(n)])
-            vals = np.concatenate([vals[keep], motor[0]])
-            cols = np.concatenate([cols[keep], np.full(n, inner.i_phi)])
+        motor = inner.motor_jacobian(y[:n], base, omega)  # a torque motor's row, else None
         J = sp.csc_matrix((vals, (rows, cols)), shape=(n, n))  # duplicates add
         # A J with J sparse (~20 entries a column), as (J^T A^T)^T
         W = -gamma_h * np.asarray((J.T @ system.mobility_matrix(y, screening=False)).T)
         W[np.diag_indices(n)] += 1.0
-        if motor:
-            W[inner.i_phi] = -gamma_h * motor[1]
+        if motor is not None:
+            W[inner.i_phi] = -gamma_h * motor
             W[inner.i_phi, inner.i_phi] += 1.0
         self.n = n
         try:
