@@ -294,7 +294,10 @@ class CellBody:
     spacing (Usabiaga et al. 2016 use blobs about half their spacing; docs/bacterium.md
     measures the convergence in both). ``solver``: how the blob matrix is solved, "direct"
     (Cholesky once, O(n^2) memory), "krylov" (conjugate gradients, O(n) memory) or "auto"
-    (direct up to 1500 blobs; :mod:`flagwrap.body.solver`).
+    (direct up to 1500 blobs; :mod:`flagwrap.body.solver`). ``shape``: "capped-cylinder" (the
+    paper's, default), "spheroid" (equatorial radius ``R_cell``, total length ``R_cell +
+    cylinder_length`` along the axis, lowest point at the clamp) or "sphere" (radius
+    ``R_cell``); every shape has its contact law, its blobs and its drawings.
     """
 
     radius: float | None = None
@@ -306,12 +309,15 @@ class CellBody:
     blob_spacing: float | None = None
     blob_radius: float | None = None
     solver: str = "auto"
+    shape: str = "capped-cylinder"
 
     DEFAULT_RADIUS_RATIO = 0.6
+    SHAPES = ("capped-cylinder", "sphere", "spheroid")
     SURFACES = ("transparent", "no-slip")
     MOTIONS = ("fixed", "free")
     #: keys added after results were stored, left out of result keys at these defaults
-    HASH_OMIT_DEFAULTS = {"surface": "transparent", "motion": "fixed", "solver": "auto"}
+    HASH_OMIT_DEFAULTS = {"surface": "transparent", "motion": "fixed", "solver": "auto",
+                          "shape": "capped-cylinder"}
 
     def __post_init__(self):
         if self.radius is not None:
@@ -331,6 +337,11 @@ class CellBody:
             _positive("body.cylinder_length", self.cylinder_length, "m")
         if not isinstance(self.enabled, bool):
             raise UserInputError(f"body.enabled must be true or false, got {self.enabled!r}")
+        if self.shape not in self.SHAPES:
+            raise UserInputError(f"body.shape must be one of {', '.join(self.SHAPES)}, got {self.shape!r}")
+        if self.shape == "sphere" and self.cylinder_length is not None:
+            raise UserInputError("body.cylinder_length does not apply to body.shape = 'sphere' "
+                                 "(its length is its diameter)")
         if self.surface not in self.SURFACES:
             raise UserInputError(f"body.surface must be one of {', '.join(self.SURFACES)}, "
                                  f"got {self.surface!r}")
@@ -372,6 +383,10 @@ class CellBody:
         return self.radius if self.radius is not None else helix_radius / self.radius_ratio
 
     def resolved_length(self, helix_radius: float) -> float:
+        """The body's length above its cap's centre height ``H``: the cylinder's, or for a
+        spheroid its total length less ``R_cell`` (a sphere: ``R_cell``)."""
+        if self.shape == "sphere":
+            return self.resolved_radius(helix_radius)
         if self.cylinder_length is not None:
             return self.cylinder_length
         return 5.0 * self.resolved_radius(helix_radius)

@@ -371,7 +371,8 @@ class FinalState(_Compute):
                 "contact_distance": self.contact_distance, "final_turns": self.final_turns,
                 "first_bead": self.first_bead}
 
-    def compute(self, turns, positions, buckled, body_radius, body_length):
+    def compute(self, turns, positions, buckled, body_radius, body_length,
+                body_shape="capped-cylinder"):
         """Classify.
 
         Parameters
@@ -384,6 +385,7 @@ class FinalState(_Compute):
             from :class:`WaitingTime`.
         body_radius, body_length : float
             ``R_cell``, cylinder length ``H`` [length].
+        body_shape : the body's shape (:class:`flagwrap.params.CellBody`)
 
         Returns
         -------
@@ -392,8 +394,9 @@ class FinalState(_Compute):
         t, x = _series(turns, positions)
         if x.ndim != 3 or x.shape[2] != 3 or x.shape[1] <= self.first_bead + 1:
             raise UserInputError(f"positions must have shape (T, N, 3) with N > first_bead + 1, got {x.shape}")
-        mask = near_body_mask(x, body_radius, body_length, self.contact_distance * float(body_radius),
-                              z_min=0.0, first_bead=self.first_bead)
+        mask = near_body_mask(x, body_radius, body_length,
+                              self.contact_distance * float(body_radius), z_min=0.0,
+                              first_bead=self.first_bead, shape=body_shape)
         self._contact = near_body_fraction(mask, self.first_bead)
         self._winding = np.abs(winding_turns(x, mask))
         self._turns = t
@@ -477,7 +480,8 @@ class BucklingAnalysis(_Compute):
     def params(self) -> dict:
         return {**self.waiting.params(), **self.final.params(), "min_section": self.min_section}
 
-    def compute(self, turns, positions, omega, length, body_radius, body_length, torque_reduced=None):
+    def compute(self, turns, positions, omega, length, body_radius, body_length, torque_reduced=None,
+                body_shape="capped-cylinder"):
         """Run all detectors.
 
         Parameters
@@ -498,7 +502,7 @@ class BucklingAnalysis(_Compute):
         t, x, om = _series(turns, positions, omega)
         self.height = free_end_height(x, length)
         self.waiting.compute(t, self.height, om)
-        self.final.compute(t, x, self.waiting.buckled, body_radius, body_length)
+        self.final.compute(t, x, self.waiting.buckled, body_radius, body_length, body_shape)
         hand = local_handedness(x)
         self.perversion_bead = perversion_index(hand, self.min_section)
         after = t > self.waiting.switch_turns

@@ -58,7 +58,7 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None) -> BucklingAna
         x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
     return a.compute(ds["turns"].values, x, ds["omega"].values,
                      float(ds.attrs["length"]), cfg.body.resolved_radius(R),
-                     cfg.body.resolved_length(R), tq)
+                     cfg.body.resolved_length(R), tq, body_shape=cfg.body.shape)
 
 
 def joint_summary(ds) -> dict:

@@ -1,4 +1,5 @@
-"""Numba kernels: distance to a capped cylinder and the WCA repulsion.
+"""Numba kernels: distance to the cell body (a capped cylinder or a spheroid) and the WCA
+repulsion.
 
 Body axis = +z; the hemispherical cap of radius ``Rc`` is centred at ``(0, 0, Rc)`` so its
 lowest point is the origin (the clamp); the cylinder continues up to ``z = Rc + H``.
@@ -38,8 +39,42 @@ def surface_distance(px, py, pz, Rc, H):
     return d, dr / d * px / rho, dr / d * py / rho, dz / d
 
 
+@nb.njit(cache=True, inline="always")
+def spheroid_distance(px, py, pz, a, c):
+    """Signed distance to the spheroid of equatorial semi-axis ``a`` and axial ``c``, centred
+    at ``(0, 0, c)`` (lowest point at the origin), to first order in the distance, and its
+    gradient: ``d = (s - 1) / |grad s|``, ``s = sqrt(rho^2/a^2 + (z - c)^2/c^2)`` (Taubin's
+    distance of the level set ``s = 1``; exact for a sphere, zero on the surface, error
+    O(d^2 / R) beside it, where the contact law acts). The gradient is d's own, so the forces
+    stay the exact gradient of the contact energy."""
+    w = pz - c
+    ia2, ic2 = 1.0 / (a * a), 1.0 / (c * c)
+    s2 = (px * px + py * py) * ia2 + w * w * ic2
+    if s2 == 0.0:
+        return -min(a, c), 0.0, 0.0, -1.0
+    s = math.sqrt(s2)
+    q = math.sqrt((px * px + py * py) * ia2 * ia2 + w * w * ic2 * ic2)
+    g = s2 - s
+    d = g / q
+    # grad d = (2 s - 1) grad s / q - g grad q / q^2, grad s = (x/a^2, y/a^2, w/c^2) / s,
+    # grad q = (x/a^4, y/a^4, w/c^4) / q
+    f1 = (2.0 * s - 1.0) / (s * q)
+    f2 = g / (q * q * q)
+    return (d, px * (f1 * ia2 - f2 * ia2 * ia2), py * (f1 * ia2 - f2 * ia2 * ia2),
+            w * (f1 * ic2 - f2 * ic2 * ic2))
+
+
+@nb.njit(cache=True, inline="always")
+def body_distance(px, py, pz, Rc, H, shape):
+    """``shape`` 0: the capped cylinder (:func:`surface_distance`); 1: the spheroid of
+    equatorial radius ``Rc`` and length ``Rc + H`` (:func:`spheroid_distance`)."""
+    if shape == 1:
+        return spheroid_distance(px, py, pz, Rc, 0.5 * (Rc + H))
+    return surface_distance(px, py, pz, Rc, H)
+
+
 @nb.njit(cache=True)
-def wca_energy_grad(x, first, Rc, H, sigma, eps, c2, grad, dist):
+def wca_energy_grad(x, first, Rc, H, sigma, eps, c2, grad, dist, shape=0):
     """WCA repulsion of beads ``first..`` from the body; adds dU/dx to ``grad``.
 
     ``U(d) = 4 eps [(sigma/d)^12 - (sigma/d)^6] + eps - c2 k (d - d_c)^2 / 2`` for
@@ -54,7 +89,7 @@ def wca_energy_grad(x, first, Rc, H, sigma, eps, c2, grad, dist):
     k2 = c2 * 72.0 * eps / (cut * cut)
     E = 0.0
     for i in range(x.shape[0]):
-        d, gx, gy, gz = surface_distance(x[i, 0], x[i, 1], x[i, 2], Rc, H)
+        d, gx, gy, gz = body_distance(x[i, 0], x[i, 1], x[i, 2], Rc, H, shape)
         dist[i] = d
         if i < first or d >= cut or d <= 0.0:
             continue

@@ -14,6 +14,11 @@ class CappedCylinder:
     the body (paper, Methods): it acts on the filament only by the WCA repulsion of range
     ``cutoff`` (bead centre to surface) and energy ``strength``.
 
+    ``shape = "spheroid"`` (or ``"sphere"``) makes it the spheroid of equatorial radius
+    ``radius`` and total length ``radius + length`` along the axis, lowest point at the
+    origin (:func:`flagwrap.body._kernels.spheroid_distance`); ``length = radius`` is the
+    sphere.
+
     Parameters
     ----------
     radius, length : float
@@ -30,8 +35,11 @@ class CappedCylinder:
     """
 
     POTENTIALS = {"wca-c2": 1.0, "wca": 0.0}
+    #: the contact kernel's shape codes
+    SHAPES = {"capped-cylinder": 0, "spheroid": 1, "sphere": 1}
 
-    def __init__(self, radius, length, cutoff, strength, first_bead=2, potential="wca-c2"):
+    def __init__(self, radius, length, cutoff, strength, first_bead=2, potential="wca-c2",
+                 shape="capped-cylinder"):
         if potential not in self.POTENTIALS:
             raise ValueError(f"contact potential must be one of {tuple(self.POTENTIALS)}, got {potential!r}")
         self.potential = potential
@@ -42,17 +50,22 @@ class CappedCylinder:
         self.sigma = self.cutoff / 2.0 ** (1.0 / 6.0)
         self.strength = float(strength)
         self.first_bead = int(first_bead)
+        if shape not in self.SHAPES:
+            raise ValueError(f"body shape must be one of {tuple(self.SHAPES)}, got {shape!r}")
+        self.shape = shape
+        self.shape_code = self.SHAPES[shape]
 
     def energy_grad(self, x: np.ndarray, grad: np.ndarray, dist: np.ndarray) -> float:
         """Adds ``dU/dx`` into ``grad`` and writes signed distances into ``dist``."""
         return K.wca_energy_grad(x, self.first_bead, self.radius, self.length, self.sigma,
-                                 self.strength, self.c2, grad, dist)
+                                 self.strength, self.c2, grad, dist, self.shape_code)
 
     def distance(self, x: np.ndarray) -> np.ndarray:
         """Signed distance of each point to the surface (negative inside)."""
         grad = np.zeros_like(x)
         dist = np.empty(len(x))
-        K.wca_energy_grad(x, len(x), self.radius, self.length, self.sigma, 0.0, 0.0, grad, dist)
+        K.wca_energy_grad(np.ascontiguousarray(x, dtype=np.float64), len(x), self.radius,
+                          self.length, self.sigma, 0.0, 0.0, grad, dist, self.shape_code)
         return dist
 
 
@@ -63,6 +76,8 @@ class NoBody:
     length = 0.0
     first_bead = 0
     c2 = 0.0
+    shape = "none"
+    shape_code = 0
 
     def energy_grad(self, x, grad, dist):
         dist[:] = np.inf

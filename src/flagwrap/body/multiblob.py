@@ -226,13 +226,40 @@ def inset_capped_cylinder_blobs(radius: float, length: float, spacing: float,
     return capped_cylinder_blobs(radius - d, max(length - d, 0.0), spacing) + np.array([0.0, 0.0, d])
 
 
+def spheroid_ring_blobs(equatorial: float, axial: float, spacing: float) -> np.ndarray:
+    """Blob centres about ``spacing`` apart on the spheroid of semi-axes ``equatorial`` and
+    ``axial``, centred at ``(0, 0, axial)`` (lowest point at the origin): rings at equal arc
+    length along the meridian, one blob at each pole (unlike the stretched icosphere of
+    :func:`spheroid_blobs`, whose blobs spread apart along a long axis)."""
+    a, c = float(equatorial), float(axial)
+    if not (a > 0 and c > 0 and 0 < spacing < min(a, c)):
+        raise UserInputError(f"spheroid: need semi-axes > 0 and 0 < spacing < both, got {a:g}, "
+                             f"{c:g}, {spacing:g}")
+    th = np.linspace(0.0, math.pi, 4001)
+    rho, z = a * np.sin(th), c * (1.0 - np.cos(th))
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(rho), np.diff(z)))])
+    n = max(2, int(round(arc[-1] / spacing)))
+    pts = [(0.0, 0.0, 0.0)]
+    for k in range(1, n):
+        t = np.interp(arc[-1] * k / n, arc, th)
+        _ring(pts, a * math.sin(t), c * (1.0 - math.cos(t)), spacing, phase=0.5 * k)
+    pts.append((0.0, 0.0, 2.0 * c))
+    return np.array(pts)
+
+
 def cell_body_blobs(config) -> tuple[np.ndarray, np.ndarray]:
     """The blobs of ``config``'s no-slip cell body in core units (lengths in ``L``): centres
-    (n, 3) inset under the surface of :class:`~flagwrap.body.cell_body.CappedCylinder` (lowest
-    point at the origin; :func:`inset_capped_cylinder_blobs`) and their radii (n,)."""
+    (n, 3) inset by ``BLOB_INSET`` blob radii under the surface of
+    :class:`~flagwrap.body.cell_body.CappedCylinder` (its shape; lowest point at the origin)
+    and their radii (n,)."""
     b, fil = config.body, config.filament
     R, L = fil.helix_radius, fil.length
     ab = b.resolved_blob_radius(R) / L
-    blobs = inset_capped_cylinder_blobs(b.resolved_radius(R) / L, b.resolved_length(R) / L,
-                                        b.resolved_blob_spacing(R) / L, ab)
+    Rc, H, sp = b.resolved_radius(R) / L, b.resolved_length(R) / L, b.resolved_blob_spacing(R) / L
+    if b.shape == "capped-cylinder":
+        blobs = inset_capped_cylinder_blobs(Rc, H, sp, ab)
+    else:  # a spheroid of semi-axes Rc and (Rc + H)/2; the inset shell keeps its centre
+        d = BLOB_INSET * ab
+        c = 0.5 * (Rc + H)
+        blobs = spheroid_ring_blobs(Rc - d, c - d, sp) + np.array([0.0, 0.0, d])
     return blobs, np.full(len(blobs), ab)

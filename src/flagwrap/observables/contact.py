@@ -14,7 +14,7 @@ from flagwrap.errors import UserInputError
 from flagwrap.observables._util import positions_array, positive
 
 
-def body_distance(positions, body_radius, body_length) -> np.ndarray:
+def body_distance(positions, body_radius, body_length, shape="capped-cylinder") -> np.ndarray:
     """Signed distance of every bead centre from the body surface.
 
     Parameters
@@ -23,6 +23,7 @@ def body_distance(positions, body_radius, body_length) -> np.ndarray:
         bead centres [length].
     body_radius, body_length : float
         ``R_cell`` and the cylinder length ``H`` [length].
+    shape : the body's shape (:class:`flagwrap.params.CellBody`)
 
     Returns
     -------
@@ -36,13 +37,13 @@ def body_distance(positions, body_radius, body_length) -> np.ndarray:
     H = float(body_length)
     if not H >= 0:
         raise UserInputError(f"body_length must be >= 0, got {body_length!r}")
-    body = CappedCylinder(Rc, H, cutoff=1.0, strength=0.0)
+    body = CappedCylinder(Rc, H, cutoff=1.0, strength=0.0, shape=shape)
     flat = np.ascontiguousarray(x.reshape(-1, 3))
     return body.distance(flat).reshape(x.shape[:-1])
 
 
 def near_body_mask(positions, body_radius, body_length, max_distance, z_min=0.0,
-                   first_bead: int = 2) -> np.ndarray:
+                   first_bead: int = 2, shape="capped-cylinder") -> np.ndarray:
     """Beads beside the body: ``distance <= max_distance`` and ``z > z_min``, from ``first_bead``.
 
     Parameters
@@ -65,7 +66,7 @@ def near_body_mask(positions, body_radius, body_length, max_distance, z_min=0.0,
     ndarray of bool, shape (..., N)
     """
     x = positions_array(positions, min_beads=1)
-    d = body_distance(x, body_radius, body_length)
+    d = body_distance(x, body_radius, body_length, shape)
     m = (d <= float(max_distance)) & (x[..., 2] > float(z_min))
     m[..., : int(first_bead)] = False
     return m

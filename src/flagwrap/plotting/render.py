@@ -88,6 +88,7 @@ class Scene:
     body_radius: float
     body_length: float
     length: float
+    body_shape: str = "capped-cylinder"
 
     @property
     def has_body(self) -> bool:
@@ -105,7 +106,7 @@ def scene_of(ds) -> Scene:
     else:
         Rc, H = 0.0, 0.0
     return Scene(float(cfg.filament.cross_section_radius), float(Rc), float(H),
-                 float(ds.attrs["length"]))
+                 float(ds.attrs["length"]), cfg.body.shape)
 
 
 def body_poses(ds):
@@ -217,12 +218,13 @@ def tube_faces(x: np.ndarray, radius: float, sides: int = 12, subdivide: int = 3
 
 
 def body_surface(radius: float, length: float, n_around: int = 48, n_cap: int = 12,
-                 n_cyl: int = 6):
+                 n_cyl: int = 6, shape: str = "capped-cylinder"):
     """Closed triangle mesh of the cell body (surface of revolution about +z).
 
     Profile: hemisphere of radius ``radius`` centred at ``(0, 0, radius)`` from its bottom
     pole at the origin to its equator, the cylinder up to ``z = radius + length``, and the
-    flat top disc.
+    flat top disc. ``shape = "spheroid"`` or ``"sphere"``: the spheroid of equatorial radius
+    ``radius`` from the origin to ``z = radius + length`` (``2 (n_cap + n_cyl)`` rings).
 
     Parameters
     ----------
@@ -235,16 +237,22 @@ def body_surface(radius: float, length: float, n_around: int = 48, n_cap: int = 
     triangles : (F, 3) int, counter-clockwise seen from outside (outward normals)
     """
     R = float(radius)
-    a = np.linspace(0.0, np.pi / 2, n_cap + 1)  # polar angle from the bottom pole
-    prof_r = list(R * np.sin(a))
-    prof_z = list(R - R * np.cos(a))
-    zc = np.linspace(R, R + length, n_cyl + 1)[1:]
-    prof_r += [R] * len(zc)
-    prof_z += list(zc)
-    # profile starts at the bottom pole (r = 0) and ends at the top centre (r = 0)
-    prof_r.append(0.0)
-    prof_z.append(R + length)
-    prof_r, prof_z = np.asarray(prof_r), np.asarray(prof_z)
+    if shape in ("spheroid", "sphere"):
+        c = 0.5 * (R + length)
+        a = np.linspace(0.0, np.pi, 2 * (n_cap + n_cyl) + 1)
+        prof_r, prof_z = R * np.sin(a), c * (1.0 - np.cos(a))
+        prof_r[-1] = 0.0
+    else:
+        a = np.linspace(0.0, np.pi / 2, n_cap + 1)  # polar angle from the bottom pole
+        prof_r = list(R * np.sin(a))
+        prof_z = list(R - R * np.cos(a))
+        zc = np.linspace(R, R + length, n_cyl + 1)[1:]
+        prof_r += [R] * len(zc)
+        prof_z += list(zc)
+        # profile starts at the bottom pole (r = 0) and ends at the top centre (r = 0)
+        prof_r.append(0.0)
+        prof_z.append(R + length)
+        prof_r, prof_z = np.asarray(prof_r), np.asarray(prof_z)
     phi = 2 * np.pi * np.arange(n_around) / n_around
     verts = [np.array([[0.0, 0.0, prof_z[0]]])]
     index = [np.zeros(n_around, dtype=int)]
@@ -314,7 +322,8 @@ class Renderer:
         self.body_rgb = np.asarray(body_rgb, float)
         self.body_alpha = float(body_alpha)
         if scene.has_body:
-            v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around)
+            v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around,
+                                shape=scene.body_shape)
             self._body = v[f]
             self._body_n = _face_normals(self._body)
         else:

@@ -49,7 +49,7 @@ def unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta):
 def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
                        base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
                        has_body, Rc, H, sigma, eps, c2, gravity,
-                       G, x, theta, gx, gth, d1_out, rt_out, dist):
+                       G, x, theta, gx, gth, d1_out, rt_out, dist, shape=0):
     """Fill ``G`` (ny,) and the work arrays; return (elastic energy, contact energy)."""
     N = x.shape[0]
     unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta)
@@ -57,7 +57,7 @@ def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
                     gx, gth, d1_out, rt_out)
     Ec = 0.0
     if has_body:
-        Ec = wca_energy_grad(x, nc, Rc, H, sigma, eps, c2, gx, dist)
+        Ec = wca_energy_grad(x, nc, Rc, H, sigma, eps, c2, gx, dist, shape)
     else:
         for i in range(N):
             dist[i] = np.inf
@@ -80,7 +80,7 @@ def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
 def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
                     nc, ec, x_ref, axis, theta_ref, twist_rate,
                     base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
-                    has_body, Rc, H, sigma, eps, c2, gravity):
+                    has_body, Rc, H, sigma, eps, c2, gravity, shape=0):
     """``J = dG/dy`` as COO triplets (duplicates to be summed), O(N) time and memory.
 
     Analytic stretching Hessian + coloured differences of the rest. The stretching springs are
@@ -109,14 +109,14 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
     vals = np.empty(n_tot)
     generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, 0.0, has_body, Rc, H, sigma,
-                       eps, c2, gravity, Gs, x, theta, gx, gth, d1, rt, dist)
+                       eps, c2, gravity, Gs, x, theta, gx, gth, d1, rt, dist, shape)
     n_groups = g_ptr.shape[0] - 1
     for g in range(n_groups):
         for q in range(g_ptr[g], g_ptr[g + 1]):
             yp[g_cols[q]] += delta
         generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                            base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, 0.0, has_body, Rc, H, sigma,
-                           eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist)
+                           eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist, shape)
         for q in range(e_ptr[g], e_ptr[g + 1]):
             r = e_rows[q]
             rows[q] = r
@@ -153,7 +153,7 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
     yp[ny - 1] += delta
     generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks, has_body, Rc, H, sigma,
-                       eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist)
+                       eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist, shape)
     for r in range(ny):
         v = (G[r] - G0[r]) / delta
         if v != 0.0:

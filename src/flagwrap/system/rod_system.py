@@ -123,6 +123,7 @@ class RodSystem:
                 strength=config.contact.strength / b,
                 first_bead=nc,
                 potential=config.contact.potential,
+                shape=config.body.shape,
             )
         else:
             self.body = body or NoBody()
@@ -222,7 +223,7 @@ class RodSystem:
         rt = np.empty_like(base.rt)
         dist = np.empty(N)
         E, Ec = SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base),
-                                      G, x, theta, gx, gth, d1, rt, dist)
+                                      G, x, theta, gx, gth, d1, rt, dist, self.body.shape_code)
         return G, x, theta, gx, gth, d1, rt, dist, E, Ec
 
     def forces(self, y: np.ndarray, base: Frames) -> ForceInfo:
@@ -443,7 +444,8 @@ class RodSystem:
             G0 = self.forces(y, base).G
         g_ptr, g_cols, e_ptr, e_rows, e_cols = self._colors_flat
         trip = SK.fd_jacobian_coo(np.ascontiguousarray(y), G0, delta, g_ptr, g_cols, e_ptr,
-                                  e_rows, e_cols, self.N, *self._kernel_args(base))
+                                  e_rows, e_cols, self.N, *self._kernel_args(base),
+                                  self.body.shape_code)
         extra = self.interaction_jacobian_coo(y, "all" if nonlocal_terms else "local")
         if not extra:
             return trip
