@@ -447,7 +447,8 @@ def style_view(ax, ulim, zlim, title: str | None = None, scale_bar: float | None
         x0 = ulim[0] + 0.05 * (ulim[1] - ulim[0])
         y0 = zlim[0] + 0.03 * (zlim[1] - zlim[0])
         ax.plot([x0, x0 + scale_bar], [y0, y0], color="k", lw=1.5, solid_capstyle="butt")
-        label = f"{scale_bar * 100:g} cm" if scale_bar >= 0.01 else f"{scale_bar * 1e3:g} mm"
+        label = (f"{scale_bar * 100:g} cm" if scale_bar >= 0.01 else
+                 f"{scale_bar * 1e3:g} mm" if scale_bar >= 1e-3 else f"{scale_bar * 1e6:g} um")
         ax.text(x0 + scale_bar / 2, y0 + 0.01 * (zlim[1] - zlim[0]), label, ha="center",
                 va="bottom", fontsize=6)
 
