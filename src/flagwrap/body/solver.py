@@ -46,9 +46,11 @@ class DirectBlobSolver:
             inv, info = lapack.dpotri(L, lower=1, overwrite_c=0)
         if info != 0:
             raise ValueError(f"the blob matrix is not positive definite (LAPACK info {info})")
-        self._L = np.tril(L)
-        inv = np.tril(inv)
-        self._inv = inv + np.tril(inv, -1).T
+        self._L = L  # its upper triangle is never read (solve_triangular, lower=True)
+        upper = np.triu(inv, 1)  # potri fills the lower triangle; the rest is Mbb's
+        inv -= upper
+        inv += np.tril(inv, -1).T
+        self._inv = inv
 
     def solve(self, r: np.ndarray) -> np.ndarray:
         """``M_bb^-1 r`` (r: (3n,) or (3n, k))."""
