@@ -52,3 +52,14 @@ def test_krylov_swimmer_moves_as_the_direct_one():
         y[s.sl_x] += 1e-2 * s.bond * rng.standard_normal(s.sl_x.stop)
         out.append(s.apply_mobility(y, s.forces(y, s.frames0).G))
     assert np.abs(out[1] - out[0]).max() < 1e-7 * np.abs(out[0]).max()
+
+
+def test_direct_solver_with_and_without_its_inverse_agree(body, monkeypatch):
+    # up to INVERSE_MAX blobs the inverse serves the solves, above it the Cholesky factor
+    b, r = body
+    rhs = np.random.default_rng(3).standard_normal((3 * len(b), 2))
+    with_inv = DirectBlobSolver(b, r)
+    monkeypatch.setattr(DirectBlobSolver, "INVERSE_MAX", 0)
+    factor = DirectBlobSolver(b, r)
+    assert with_inv._inv is not None and factor._inv is None
+    assert np.allclose(with_inv.solve(rhs), factor.solve(rhs), rtol=1e-12, atol=0)

@@ -4,8 +4,8 @@ Every product of the no-slip body's mobilities (:class:`~flagwrap.hydrodynamics.
 FixedBodyMobility`, :class:`~flagwrap.system.swimmer.SwimmerSystem`) needs ``M_bb^-1 r``.
 The blobs do not move in the body's frame, so ``M_bb`` is the same for a whole run.
 
-* :class:`DirectBlobSolver`: its inverse, computed once from its Cholesky factor: O(n^2)
-  memory (a 4000-blob body is a 12000^2 matrix, 1.15 GB), each solve one O(n^2) product.
+* :class:`DirectBlobSolver`: its Cholesky factor, and up to 1500 blobs its inverse, computed
+  once: O(n^2) memory (a 4000-blob body is a 12000^2 matrix, 1.15 GB), each solve O(n^2).
 * :class:`KrylovBlobSolver`: conjugate gradients (``M_bb`` is symmetric positive definite)
   with the matrix applied on the fly (the RPY sum, O(n) memory) and a block-Jacobi
   preconditioner: the blobs cut into spatial clusters of about ``block`` blobs (a k-d
@@ -27,13 +27,16 @@ KINDS = ("auto", "direct", "krylov")
 
 
 class DirectBlobSolver:
-    """``M_bb^-1`` itself, from its Cholesky factor (LAPACK potrf + potri), computed once.
+    """``M_bb`` factorised once (LAPACK potrf); up to ``INVERSE_MAX`` blobs its inverse too.
 
-    A solve is then one matrix-vector product: one pass over the n^2 numbers where the two
-    triangular solves make two slower ones (344 blobs: 0.11 ms against 0.48 ms on one core;
-    the same to 4e-15). The factor is kept too, for the screening matrix (twice the memory)."""
+    With the inverse a solve is one matrix-vector product: one pass over the n^2 numbers where
+    the two triangular solves make two slower ones (344 blobs: 0.11 ms against 0.48 ms on one
+    core; the same to 4e-15). Above ``INVERSE_MAX`` blobs the inverse's memory (and its
+    temporaries: a 3875-blob body peaks at 5.5 GB with it, 2.2 GB without) outweighs that, and
+    the factor alone solves."""
 
     kind = "direct"
+    INVERSE_MAX = 1500
 
     def __init__(self, blobs: np.ndarray, radii: np.ndarray):
         from scipy.linalg import lapack
@@ -42,19 +45,23 @@ class DirectBlobSolver:
 
         Mbb = PolydisperseRPY(radii).matrix(blobs)
         L, info = lapack.dpotrf(Mbb, lower=1, overwrite_a=1)
-        if info == 0:
-            inv, info = lapack.dpotri(L, lower=1, overwrite_c=0)
         if info != 0:
             raise ValueError(f"the blob matrix is not positive definite (LAPACK info {info})")
-        self._L = L  # its upper triangle is never read (solve_triangular, lower=True)
-        upper = np.triu(inv, 1)  # potri fills the lower triangle; the rest is Mbb's
-        inv -= upper
-        inv += np.tril(inv, -1).T
-        self._inv = inv
+        self._L = L  # its upper triangle is never read (lower=True everywhere)
+        self._inv = None
+        if len(blobs) <= self.INVERSE_MAX:
+            inv, info = lapack.dpotri(L, lower=1, overwrite_c=0)
+            if info != 0:
+                raise ValueError(f"the blob matrix could not be inverted (LAPACK info {info})")
+            inv -= np.triu(inv, 1)  # potri fills the lower triangle; the rest is Mbb's
+            inv += np.tril(inv, -1).T
+            self._inv = inv
 
     def solve(self, r: np.ndarray) -> np.ndarray:
         """``M_bb^-1 r`` (r: (3n,) or (3n, k))."""
-        return self._inv @ r
+        if self._inv is not None:
+            return self._inv @ r
+        return sla.cho_solve((self._L, True), r, check_finite=False)
 
     def screening(self, C: np.ndarray) -> np.ndarray:
         """``C M_bb^-1 C^T`` as ``Y^T Y``, ``Y = L^-1 C^T``: half the operations of
