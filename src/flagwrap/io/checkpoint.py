@@ -13,7 +13,8 @@ item                       meaning (core units: length L, time 1/omega)
 attrs ``t, h, next_save``  time, the step-size controller's next step, the next output time
 attrs ``t_end``            end of the run
 attrs ``n_steps, ...``     accepted / rejected step counters, wall time so far
-``records/<name>``         the trajectory recorded so far (:meth:`Trajectory.arrays` names)
+``records/<name>``         the trajectory recorded so far (:meth:`Trajectory.arrays` names; a free
+                           body's ``body`` record when the run has one)
 attrs ``config_toml``      the full input; resume refuses a different one
 attrs ``flagwrap_version`` resume refuses a checkpoint from another version
 =========================  ====================================================================
@@ -42,6 +43,8 @@ _MAGIC = "flagwrap checkpoint"
 RECORD_NAMES = ("t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
                 "contact_energy", "min_distance", "max_strain", "interaction_energy",
                 "hook_angle", "hook_torque", "hook_twist_torque")
+#: records only some runs have (a free body's pose and velocities): stored when present
+OPTIONAL_RECORD_NAMES = ("body",)
 _SCALARS = {"t": float, "t_end": float, "h": float, "next_save": float, "n_steps": int,
             "n_rejected": int, "wall_time": float}
 
@@ -95,7 +98,7 @@ def write_checkpoint(ckpt: Checkpoint, path) -> Path:
             for k in ("y", "base_t", "base_d1", "base_rt"):
                 _checked(f, k, getattr(ckpt, k))
             g = f.create_group("records")
-            for k in RECORD_NAMES:
+            for k in RECORD_NAMES + tuple(k for k in OPTIONAL_RECORD_NAMES if k in ckpt.records):
                 _checked(g, k, ckpt.records[k])
 
     return atomic_write(path, write, sync_dir=True)
@@ -125,7 +128,9 @@ def read_checkpoint(path) -> Checkpoint:
             kw["flagwrap_version"] = str(f.attrs["flagwrap_version"])
             for k in ("y", "base_t", "base_d1", "base_rt"):
                 kw[k] = np.array(f[k][()], dtype=np.float64)
-            kw["records"] = {k: np.array(f["records"][k][()], dtype=np.float64) for k in RECORD_NAMES}
+            kw["records"] = {k: np.array(f["records"][k][()], dtype=np.float64)
+                             for k in RECORD_NAMES + OPTIONAL_RECORD_NAMES
+                             if k in RECORD_NAMES or k in f["records"]}
             if "scalars" in f and not np.array_equal(
                     f["scalars"][()], np.array([float(kw[k]) for k in _SCALARS])):
                 raise ValueError("scalar attributes differ from their checksummed copy")
