@@ -22,7 +22,6 @@ interrupted analysis never damages the run.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
