@@ -13,15 +13,7 @@ import math
 
 import numpy as np
 
-
-def quaternion_matrices(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices (n, 3, 3) of unit quaternions ``q`` (n, 4) = (w, x, y, z)."""
-    q = q / np.linalg.norm(q, axis=1)[:, None]
-    w, x, y, z = q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], 1)
+from flagwrap.geometry.frames import quaternion_matrix as quaternion_matrices  # (n, 4) -> (n, 3, 3)
 
 
 def body_frame(position: np.ndarray, body_position: np.ndarray,

@@ -46,17 +46,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.rotating import RotatingFrame, check_rotating_frame, subtract_rotation
-
-
-def quaternion_matrix(q) -> np.ndarray:
-    """Rotation matrix of the quaternion ``q = (w, x, y, z)`` (normalised here)."""
-    w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def quaternion_rate(q, omega_body) -> np.ndarray:
