@@ -142,14 +142,15 @@ def check_spacing(blobs: np.ndarray, blob_radius: float, what: str = "body.blob_
 def geometric_matrix(blobs: np.ndarray) -> np.ndarray:
     """``K`` (3n x 6): blob velocities ``u = K [U; Omega]`` of a rigid motion about the
     origin of the ``blobs`` coordinates."""
-    n = len(blobs)
-    K = np.zeros((3 * n, 6))
-    for i, r in enumerate(blobs):
-        K[3 * i:3 * i + 3, :3] = np.eye(3)
-        # Omega x r = -[r]_x Omega
-        K[3 * i:3 * i + 3, 3:] = -np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]],
-                                            [-r[1], r[0], 0.0]])
-    return K
+    r = np.asarray(blobs, float)
+    n = len(r)
+    K = np.zeros((n, 3, 6))
+    K[:, [0, 1, 2], [0, 1, 2]] = 1.0
+    # Omega x r = -[r]_x Omega
+    K[:, 0, 4], K[:, 0, 5] = r[:, 2], -r[:, 1]
+    K[:, 1, 3], K[:, 1, 5] = -r[:, 2], r[:, 0]
+    K[:, 2, 3], K[:, 2, 4] = r[:, 1], -r[:, 0]
+    return K.reshape(3 * n, 6)
 
 
 def blob_mobility(blobs: np.ndarray, blob_radius: float) -> np.ndarray:

@@ -46,6 +46,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from flagwrap.body.multiblob import geometric_matrix
 from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.rotating import RotatingFrame, check_rotating_frame, subtract_rotation
@@ -68,7 +69,6 @@ class SwimmerSystem:
     """
 
     def __init__(self, system, blobs, blob_radii, solver: str = "direct"):
-        from flagwrap.body.multiblob import geometric_matrix
         from flagwrap.body.solver import make_blob_solver
 
         if not system.mobility.long_range or getattr(system.mobility, "backend", "") != "direct":
@@ -83,7 +83,8 @@ class SwimmerSystem:
         self.K = geometric_matrix(self.blobs)
         self._MinvK = self._solver.solve(self.K)  # (3 n_blob, 6)
         #: the body's own mobility (K^T M_bb^-1 K)^-1, viscosity 1, about the reference point
-        self.body_mobility = np.linalg.inv(0.5 * (self.K.T @ self._MinvK + (self.K.T @ self._MinvK).T))
+        R = self.K.T @ self._MinvK
+        self.body_mobility = np.linalg.inv(0.5 * (R + R.T))
         s = system
         self.n_in = s.ny
         self.layout = DofLayout([(b.name, b.kind, b.size) for b in s.layout.blocks]
@@ -199,16 +200,8 @@ class SwimmerSystem:
         idx = np.arange(n3, n3 + s.ne)
         A[idx, idx] = s.twist_mobility * s.machin
         D = np.zeros((6, self.n_in))
-        D[:, :n3] = (C @ self._MinvK).T
-        # - S: [I; [x]_x] per bead, [0; t] per bond
-        D[:3, :n3] -= np.tile(np.eye(3), (1, s.nb))
-        Dx = D[3:, :n3].reshape(3, s.nb, 3)
-        Dx[0, :, 1] += xf[:, 2]
-        Dx[0, :, 2] -= xf[:, 1]
-        Dx[1, :, 0] -= xf[:, 2]
-        Dx[1, :, 2] += xf[:, 0]
-        Dx[2, :, 0] += xf[:, 1]
-        Dx[2, :, 1] -= xf[:, 0]
+        # - S: the beads' rigid-motion matrix transposed, [I; [x]_x] per bead; [0; t] per bond
+        D[:, :n3] = (C @ self._MinvK).T - geometric_matrix(xf).T
         D[3:, n3:n3 + s.ne] -= t.T
         A += D.T @ self.body_mobility @ D
         return A / s.machin
@@ -251,11 +244,8 @@ class SwimmerW:
 
         n = system.n_in
         inner = system.inner
-        import scipy.sparse as sp
-
-        rows, cols, vals = system.force_jacobian_coo(y, base, G0[:n])
+        J = inner.force_jacobian_sparse(y[:n], base, G0[:n])
         motor = inner.motor_jacobian(y[:n], base, omega)  # a torque motor's row, else None
-        J = sp.csc_matrix((vals, (rows, cols)), shape=(n, n))  # duplicates add
         # A J with J sparse (~20 entries a column), as (J^T A^T)^T
         W = -gamma_h * np.asarray((J.T @ system.mobility_matrix(y, screening=False)).T)
         W[np.diag_indices(n)] += 1.0
