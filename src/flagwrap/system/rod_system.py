@@ -313,12 +313,13 @@ class RodSystem:
         row = np.zeros(self.ny)
         near = [3 * k + c for k in range(min(3, self.nb)) for c in range(3)]
         near += [self.sl_th.start + j for j in range(min(3, self.ne))] + [self.i_phi]
+        yp = np.array(y, float)
         for k in near:
-            yp = np.array(y, float)
             yp[k] = y[k] + h
             gp = self.motor_force(yp, self.forces(yp, base))
             yp[k] = y[k] - h
             gm = self.motor_force(yp, self.forces(yp, base))
+            yp[k] = y[k]
             row[k] = m * (gp - gm) / (2 * h)
         return row
 
