@@ -1007,13 +1007,8 @@ class Config:
                 d.pop("joint", None)
             if not self.contact.self_contact:
                 d["contact"].pop("self_contact", None)
-            for k, v in Numerics.HASH_OMIT_DEFAULTS.items():
-                if d["numerics"].get(k) == v:
-                    d["numerics"].pop(k)
-            for k, v in CellBody.HASH_OMIT_DEFAULTS.items():
-                if d["body"].get(k) == v:
-                    d["body"].pop(k)
-            for k, v in Motor.HASH_OMIT_DEFAULTS.items():
-                if d["motor"].get(k) == v:
-                    d["motor"].pop(k)
+            for section, cls in (("numerics", Numerics), ("body", CellBody), ("motor", Motor)):
+                for k, v in cls.HASH_OMIT_DEFAULTS.items():
+                    if d[section].get(k) == v:
+                        d[section].pop(k)
         return d

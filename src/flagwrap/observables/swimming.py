@@ -36,6 +36,12 @@ def _rotation_angle_about(R0: np.ndarray, R1: np.ndarray, axis: np.ndarray) -> f
     return float(th * (v @ axis))
 
 
+def turn_angles(R: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """The body's turn [rad] between successive frames ``R`` (F, 3, 3), each about its own
+    axis ``axes`` (F - 1, 3) (:func:`_rotation_angle_about`)."""
+    return np.array([_rotation_angle_about(R[k], R[k + 1], axes[k]) for k in range(len(R) - 1)])
+
+
 def phase_summary(t, phi, body_position, body_orientation, t0, t1) -> dict:
     """The swimmer over ``[t0, t1]`` (SI: s, rad, m): its speed along the body axis (+ = body
     first, away from the filament) [m/s], the body's rotation rate about its axis [Hz] (+ =
@@ -52,11 +58,8 @@ def phase_summary(t, phi, body_position, body_orientation, t0, t1) -> dict:
     axis /= np.linalg.norm(axis)
     dt = t[j] - t[i]
     dX = float((np.asarray(body_position)[j] - np.asarray(body_position)[i]) @ axis)
-    # the body's turn over the window, in pieces below pi
-    ang = 0.0
     Rk = quaternion_matrices(np.asarray(body_orientation, float)[k])
-    for a, b in zip(Rk[:-1], Rk[1:]):
-        ang += _rotation_angle_about(a, b, axis)
+    ang = sum(turn_angles(Rk, np.broadcast_to(axis, (len(Rk) - 1, 3))))  # pieces below pi
     dphi = float(np.asarray(phi)[j] - np.asarray(phi)[i])
     return dict(speed=dX / dt, body_rotation_hz=ang / dt / (2 * math.pi),
                 motor_rate_hz=dphi / dt / (2 * math.pi),

@@ -16,7 +16,7 @@ def swimming_series(ds) -> dict:
     """Time series of a free swimmer's run dataset (SI): ``t``, ``displacement`` along the
     initial body axis, ``motor_hz`` and ``body_hz`` (rates between saved frames, at their
     midpoints ``t_mid``), ``height`` of the free end in the body frame over L."""
-    from flagwrap.observables.swimming import _rotation_angle_about, body_frame, quaternion_matrices
+    from flagwrap.observables.swimming import body_frame, quaternion_matrices, turn_angles
 
     t = ds["time"].values
     X = ds["body_position"].values
@@ -25,8 +25,7 @@ def swimming_series(ds) -> dict:
     disp = (X - X[0]) @ e0
     phi = ds["motor_angle"].values
     dt = np.diff(t)
-    turn = np.array([_rotation_angle_about(R[k], R[k + 1], 0.5 * (R[k][:, 2] + R[k + 1][:, 2]))
-                     for k in range(len(t) - 1)])
+    turn = turn_angles(R, 0.5 * (R[:-1, :, 2] + R[1:, :, 2]))
     xb = body_frame(ds["position"].values, X, ds["body_orientation"].values)
     L = float(ds.attrs["length"])
     return dict(t=t, displacement=disp, t_mid=0.5 * (t[1:] + t[:-1]),
