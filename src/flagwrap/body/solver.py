@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
+from scipy.linalg.blas import dsymv as _symv
 
 #: most blobs for which "auto" takes the direct solver (a 1500-blob factor is 162 MB)
 AUTO_DIRECT_MAX = 1500
@@ -56,10 +57,15 @@ class DirectBlobSolver:
             inv -= np.triu(inv, 1)  # potri fills the lower triangle; the rest is Mbb's
             inv += np.tril(inv, -1).T
             self._inv = inv
+            # the same symmetric matrix in Fortran order, which BLAS takes without a copy
+            self._inv_f = inv if inv.flags.f_contiguous else inv.T
 
     def solve(self, r: np.ndarray) -> np.ndarray:
-        """``M_bb^-1 r`` (r: (3n,) or (3n, k))."""
+        """``M_bb^-1 r`` (r: (3n,) or (3n, k)). One right-hand side: BLAS symv, which reads one
+        triangle of the symmetric inverse (1410 unknowns: 0.28 ms against gemv's 0.76)."""
         if self._inv is not None:
+            if r.ndim == 1:
+                return _symv(1.0, self._inv_f, r, lower=1)
             return self._inv @ r
         return sla.cho_solve((self._L, True), r, check_finite=False)
 
