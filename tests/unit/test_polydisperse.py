@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from flagwrap.hydrodynamics.mobility import RPYMobility
-from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, _pair
+from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, _pair, rpy_cross_radii
 
 
 def test_equal_radii_give_the_equal_size_rpy_tensor():
@@ -55,6 +55,23 @@ def test_matrix_is_symmetric_positive_definite_for_any_configuration(seed, n):
     M = PolydisperseRPY(radii).matrix(x)
     np.testing.assert_allclose(M, M.T, atol=1e-15)
     assert np.linalg.eigvalsh(M).min() > 0.0
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(min_value=0, max_value=10**6))
+def test_cross_block_is_the_full_matrix_block(seed):
+    # the beads x blobs kernel (its own fast path for apart pairs) against the generic
+    # matrix of all spheres together, with apart, overlapping and engulfed pairs
+    rng = np.random.default_rng(seed)
+    n, m, a = 7, 11, 0.05
+    x = rng.uniform(-0.5, 0.5, (n, 3))
+    y = rng.uniform(-0.5, 0.5, (m, 3))
+    y[0] = x[0]  # a coincident pair
+    b = rng.uniform(0.02, 0.4, m)
+    M = PolydisperseRPY(np.concatenate([np.full(n, a), b])).matrix(np.vstack([x, y]))
+    C = np.empty((3 * n, 3 * m))
+    rpy_cross_radii(x, a, y, b, C)
+    np.testing.assert_allclose(C, M[:3 * n, 3 * n:], rtol=0, atol=1e-14 * np.abs(M).max())
 
 
 def _sphere_body(level=3):

@@ -89,6 +89,11 @@ def quaternion_matrix(q) -> np.ndarray:
     """Rotation matrix of the quaternion ``q = (w, x, y, z)`` (normalised here); ``q`` of shape
     (..., 4) gives (..., 3, 3) (a free body's orientation, one or every frame)."""
     q = np.asarray(q, float)
+    if q.ndim == 1:  # one pose (a swimmer's every velocity): the same entries without stacking
+        w, x, y, z = (q / math.sqrt(q @ q)).tolist()
+        return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
     w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)
     return np.stack([
         np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),

@@ -52,6 +52,18 @@ from flagwrap.system.layout import DofLayout
 from flagwrap.system.rotating import RotatingFrame, check_rotating_frame, subtract_rotation
 
 
+def _cross_rows(a, b) -> np.ndarray:
+    """``a x b`` row by row, ``a`` (n, 3) or (3,), ``b`` (n, 3): numpy's formula without its
+    axis handling, which costs more than the products at a swimmer's every velocity."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+    out = np.empty(b.shape)
+    out[:, 0] = a1 * b2 - a2 * b1
+    out[:, 1] = a2 * b0 - a0 * b2
+    out[:, 2] = a0 * b1 - a1 * b0
+    return out
+
+
 def quaternion_rate(q, omega_body) -> np.ndarray:
     """``dq/dt = q (0, Omega) / 2`` for the body-frame angular velocity ``Omega``."""
     w, x, y, z = q
@@ -147,7 +159,7 @@ class SwimmerSystem:
 
     def _load(self, xf, t, F, tau) -> np.ndarray:
         """``S G = [sum F; sum x x F + sum tau t]`` (6,)."""
-        return np.concatenate([F.sum(axis=0), np.cross(xf, F).sum(axis=0) + tau @ t])
+        return np.concatenate([F.sum(axis=0), _cross_rows(xf, F).sum(axis=0) + tau @ t])
 
     def body_velocity(self, y, G) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(V, v_beads, lambda)``: the body's ``[U; Omega]`` (body axes, core units), the free
@@ -174,7 +186,7 @@ class SwimmerSystem:
         V, v, _, xf, t = self._solve(y, G)
         U, Om = V[:3], V[3:]
         out = np.zeros(self.ny)
-        out[s.sl_x] = (v - U - np.cross(Om, xf)).ravel()
+        out[s.sl_x] = (v - U - _cross_rows(Om, xf)).ravel()
         out[s.sl_th] = s.twist_mobility * G[s.sl_th] - t @ Om
         q = y[self.sl_q] / np.linalg.norm(y[self.sl_q])
         out[self.sl_X] = quaternion_matrix(q) @ U
