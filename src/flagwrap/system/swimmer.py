@@ -106,6 +106,7 @@ class SwimmerSystem:
         self.sl_q = self.layout["body_q"]
         self._cross = np.empty((3 * s.nb, 3 * len(self.blobs)))
         self._geometry_y = None
+        self._a_buffers = None
 
     def __getattr__(self, name):  # everything not overridden is the filament system's
         return getattr(self.inner, name)
@@ -202,18 +203,27 @@ class SwimmerSystem:
         info = self.forces(y, base)
         return self.velocity(y, info, omega), info
 
-    def mobility_matrix(self, y, screening: bool = True) -> np.ndarray:
+    def mobility_matrix(self, y, screening: bool = True, reuse: bool = False) -> np.ndarray:
         """Dense ``A`` over the filament's unknowns (n_in, n_in; motor-angle row and column 0):
         ``A_fixed + D^T N D``, ``D = E - S``.
 
         ``screening=False``: without the fixed surface's screening ``M_fb M_bb^-1 M_bf`` (the
         stage solver's ``W``: that term costs a triangular solve with every bead as right-hand
-        side, ~90 % of a step, and is smooth, so the stiff local modes hardly see it)."""
+        side, ~90 % of a step, and is smooth, so the stiff local modes hardly see it).
+        ``reuse=True`` (the stage solver, once a step): built in buffers the system keeps, so
+        the result is valid until the next reusing call."""
         s = self.inner
         xf, t, C = self._geometry(y)
         n3 = 3 * s.nb
-        A = np.zeros((self.n_in, self.n_in))
-        A[:n3, :n3] = s.mobility.matrix(xf)
+        if reuse:
+            if self._a_buffers is None:
+                self._a_buffers = (np.empty((self.n_in, self.n_in)),
+                                   np.empty((self.n_in, self.n_in)), np.empty((n3, n3)))
+            A, tmp, Mff = self._a_buffers
+            A.fill(0.0)
+        else:
+            A, tmp, Mff = np.zeros((self.n_in, self.n_in)), None, None
+        A[:n3, :n3] = s.mobility.matrix(xf, out=Mff)
         if screening:
             from flagwrap.body.solver import screening_matrix
 
@@ -224,8 +234,13 @@ class SwimmerSystem:
         # - S: the beads' rigid-motion matrix transposed, [I; [x]_x] per bead; [0; t] per bond
         D[:, :n3] = (C @ self._MinvK).T - geometric_matrix(xf).T
         D[3:, n3:n3 + s.ne] -= t.T
-        A += D.T @ self.body_mobility @ D
-        return A / s.machin
+        ND = self.body_mobility @ D
+        if tmp is None:
+            A += D.T @ ND
+        else:
+            A += np.matmul(D.T, ND, out=tmp)
+        A /= s.machin
+        return A
 
     def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
         """The stage solver: dense LU of ``I - gamma h A J`` on the filament, identity on the
@@ -268,8 +283,9 @@ class SwimmerW:
         J = inner.force_jacobian_sparse(y[:n], base, G0[:n])
         motor = inner.motor_jacobian(y[:n], base, omega)  # a torque motor's row, else None
         # A J with J sparse (~20 entries a column), as (J^T A^T)^T
-        W = -gamma_h * np.asarray((J.T @ system.mobility_matrix(y, screening=False)).T)
-        W[np.diag_indices(n)] += 1.0
+        W = np.asarray((J.T @ system.mobility_matrix(y, screening=False, reuse=True)).T)
+        W *= -gamma_h
+        W.flat[::n + 1] += 1.0
         if motor is not None:
             W[inner.i_phi] = -gamma_h * motor
             W[inner.i_phi, inner.i_phi] += 1.0
