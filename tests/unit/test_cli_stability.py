@@ -64,3 +64,26 @@ def test_sweep_mode_writes_one_row_per_geometry_and_a_fit(tiny, capsys):
     assert len(res["rows"]) == 3 and all(r["converged"] for r in res["rows"])
     assert res["fit"]["n"] == 3 and res["fit"]["exponent"] > 0
     assert "fit over 3 helices" in text
+
+
+def test_a_torque_speed_motor_is_judged_against_the_whirls_torque(tiny, capsys):
+    # the same threshold as the speed motor's, plus the verdict: a line whose stall torque is
+    # 1.5x / 0.7x the one the whirl needs buckles / does not, and the text says which
+    from flagwrap.cli.main import main
+
+    main(["stability", str(tiny / "tiny.toml"), "--json"])
+    ref = json.loads(capsys.readouterr().out)
+    assert ref["motor"] is None
+    need = None
+    for k, word in ((None, None), (1.5, "it buckles"), (0.7, "stops short")):
+        stall = 1.0 if k is None else k * need  # the first pass only measures the need
+        motor = f"machin = 100\nkind = 'torque-speed'\nstall_torque = {stall!r}\nzero_load_speed = 1e3"
+        (tiny / "ts.toml").write_text(tiny_toml().replace("machin = 100", motor))
+        if k is None:
+            assert main(["stability", str(tiny / "ts.toml"), "--json"]) == 0
+            s = json.loads(capsys.readouterr().out)
+            assert s["machin_c"] == pytest.approx(ref["machin_c"], rel=1e-12)
+            need = s["motor"]["stall_torque_needed"]
+            continue
+        assert main(["stability", str(tiny / "ts.toml")]) == 0
+        assert word in capsys.readouterr().out

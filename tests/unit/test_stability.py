@@ -192,5 +192,52 @@ def test_a_buoyant_helix_starts_by_switching_gravity_on_in_steps():
     g0 = frame.system.gravity.copy()
     st = start_state(frame, 10.0)
     np.testing.assert_array_equal(frame.system.gravity, g0)  # gravity restored
+    # a fixed point: the Newton update still left, J^-1 f, is at rounding (measured 1e-15 L;
+    # 1e-12 is far below Newton's 1e-10 step tolerance). The velocity itself sits at the
+    # stiff stretching forces' rounding floor (~1e-9 L omega here), which moves with the BLAS
     f, _ = frame.velocity(st.z, st.base, st.machin)
-    assert st.converged and np.max(np.abs(f)) < 1e-9
+    J = frame.jacobian(st.z, st.base, st.machin)
+    assert st.converged and np.max(np.abs(np.linalg.solve(J, f))) < 1e-12
+
+
+def test_whirl_torque_is_the_lab_integrators_motor_torque(cw31):
+    # independent of the frame's formula: the lab-frame time integrator started on the steady
+    # whirl at the top of the bracket records the motor torque its own way (its torque
+    # balance on the driven angle, every saved step). Over one turn the whirl stays put to
+    # the integration error (tol 1e-8), so the two agree to 1e-5
+    from flagwrap.stability.threshold import whirl_torque
+
+    frame, r = cw31
+    st = r.state
+    s = frame.system
+    cfg = s.config.replace(
+        motor=dataclasses.replace(s.config.motor, machin=st.machin, protocol=(Phase("cw", 1.0, 1.0),)),
+        numerics=dataclasses.replace(s.config.numerics, tol=1e-8, save_every=0.25))
+    tr = Simulation(cfg, system=RodSystem(cfg)).run(y0=frame.full(st.z), base=st.base)
+    assert tr.ok
+    tq = np.abs(tr.arrays()["motor_torque"])
+    assert np.allclose(tq, whirl_torque(r), rtol=1e-5)
+
+
+def test_motor_verdict_compares_the_motors_torque_at_f_c_with_the_whirls(cw31):
+    # a torque-speed line just above / below the stall torque T_c / (1 - f_c / f_0) the
+    # whirl needs, a constant torque just above / below T_c
+    from flagwrap.params import Motor
+    from flagwrap.stability.threshold import motor_verdict
+
+    frame, r = cw31
+    cfg = frame.system.config
+    r = dataclasses.replace(r, frequency_c=0.5)  # Hz: the test's own (the verdict works in SI)
+    probe = motor_verdict(Motor(machin=100.0, kind="torque", stall_torque=1.0), cfg, r)
+    T_c = probe["torque_c"]
+    f0 = 2.0
+    need = T_c / (1 - r.frequency_c / f0)
+    for k, expect in ((1.01, True), (0.99, False)):
+        v = motor_verdict(Motor(machin=100.0, kind="torque-speed", stall_torque=k * need,
+                                zero_load_speed=f0), cfg, r)
+        assert v["buckles"] is expect and v["stall_torque_needed"] == pytest.approx(need)
+        v = motor_verdict(Motor(machin=100.0, kind="torque", stall_torque=k * T_c), cfg, r)
+        assert v["buckles"] is expect
+    slow = motor_verdict(Motor(machin=100.0, kind="torque-speed", stall_torque=1e3 * need,
+                               zero_load_speed=0.4), cfg, r)  # f_0 below f_c: never
+    assert slow["buckles"] is False and slow["stall_torque_needed"] == float("inf")

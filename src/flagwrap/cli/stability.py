@@ -6,7 +6,9 @@ eigenvalues of its Jacobian are computed along the way, and M_c is where the lea
 first crosses zero. Prints M_c, omega_c (SI), the crossing type (Hopf: a complex pair, with
 its frequency in the turning frame; steady: a real eigenvalue) and the steady shape at M_c.
 The config's motor protocol and M are not used; its geometry, fluid, body, joint and
-numerics.hydrodynamics are. Method and validation: docs/stability.md.
+numerics.hydrodynamics are. A torque or torque-speed motor ([motor] kind) is also judged: the
+torque the whirl needs at f_c against the motor's there, whether it buckles the filament, and
+the stall torque it would take. Method and validation: docs/stability.md.
 
 Exit status: 0 found, 1 no crossing in the range or the branch lost (what was found is
 printed), 2 bad input.
@@ -156,9 +158,26 @@ def run(args) -> int:
     print(f"steady shape at M_c: free end {(tip - res.tip_z0):+.4f} L above its rest height "
           f"({(tip - res.tip_z0) * L * 1e3:+.3g} mm)")
     print(f"M_c / scaling line 0.06 (R/L)^-3 = {res.machin_c / cfg.machin_critical_scaling:.2f}")
+    if res.motor is not None:
+        print(_motor_line(res.motor))
     for f in files:
         print(f"wrote {f}")
     return 0
+
+
+def _motor_line(v) -> str:
+    """The torque motor's verdict (:func:`flagwrap.stability.threshold.motor_verdict`)."""
+    pn = 1e21  # N m -> pN nm
+    curve = (f"stall {v['stall_torque'] * pn:.4g} pN nm, zero load {v['zero_load_speed']:.4g} Hz"
+             if v["kind"] == "torque-speed" else f"{v['stall_torque'] * pn:.4g} pN nm")
+    head = (f"motor ({v['kind']}, {curve}): the whirl at f_c needs {v['torque_c'] * pn:.4g} pN nm "
+            f"and the motor gives {v['torque_available'] * pn:.4g} there: ")
+    if v["buckles"]:
+        return head + "it turns the filament past its threshold (it buckles)"
+    need = v["stall_torque_needed"]
+    more = (f"a stall torque above {need * pn:.4g} pN nm would" if math.isfinite(need) else
+            "its zero-load speed is below f_c, so no stall torque would")
+    return head + f"it stops short of the threshold; {more}"
 
 
 def _write_mode(res, cfg, args) -> list:

@@ -73,6 +73,7 @@ class StabilityResult:
     state: object = field(default=None, repr=False)  # steady state at the top of the bracket
     frame: object = field(default=None, repr=False)  # the RotatingFrame it was computed in
     wall_time: float = 0.0
+    motor: dict | None = None  # a torque motor's verdict (motor_verdict), else None
 
     def summary(self) -> dict:
         return {
@@ -83,7 +84,7 @@ class StabilityResult:
             "frequency_c": self.frequency_c,
             "mode_frequency_si": self.mode_frequency * self.omega_c,
             "tip_z0": self.tip_z0, "wall_time": self.wall_time,
-            "branch": [p.as_dict() for p in self.branch],
+            "branch": [p.as_dict() for p in self.branch], "motor": self.motor,
         }
 
 
@@ -258,13 +259,61 @@ def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m
                          **kw) -> StabilityResult:
     """:func:`find_critical` for a config: its system, turning at the reference speed in
     ``direction`` ("cw" or "ccw"), from ``m_start`` to ``m_max`` (:func:`resolve_m_max`).
-    Refuses a bad range or a system the turning frame does not fit before any work."""
-    if config.motor.kind != "speed":
-        from flagwrap.errors import UserInputError
+    Refuses a bad range or a system the turning frame does not fit before any work.
 
-        raise UserInputError(f"stability needs motor.kind = 'speed' (the threshold is in the "
-                             f"motor's rate), got {config.motor.kind!r}")
+    A torque motor (``motor.kind`` "torque" or "torque-speed") is replaced by a speed motor
+    at its reference frequency for the threshold, and the result gets ``res.motor``
+    (:func:`motor_verdict`): whether that motor can drive the whirl past it."""
+    import dataclasses
+
+    drive = None
+    if config.motor.kind != "speed":
+        drive = config.motor
+        config = config.replace(motor=dataclasses.replace(drive, kind="speed", stall_torque=None,
+                                                          zero_load_speed=None))
     m_max = resolve_m_max(config, m_start, m_max)
     frame = make_frame(config, DIRECTIONS[direction])
-    return find_critical(frame, m_start=m_start, m_max=m_max, omega_si=config.omega,
-                         machin_si=config.machin, **kw)
+    res = find_critical(frame, m_start=m_start, m_max=m_max, omega_si=config.omega,
+                        machin_si=config.machin, **kw)
+    if drive is not None:
+        res.motor = motor_verdict(drive, config, res)
+    return res
+
+
+def whirl_torque(res) -> float:
+    """|torque| the motor supplies to the steady whirl at the top of ``res``'s bracket (core
+    units ``A/L``): the clamp's generalized force ``dE/dphi`` plus the clamped bond's
+    rotational drag at that M (:meth:`~flagwrap.system.rod_system.RodSystem.motor_torque`)."""
+    if res.state is None:
+        return math.nan
+    frame, st = res.frame, res.state
+    s = frame.system
+    dEdphi = s.clamp.generalized_force(0.0, st.info.grad_x, st.info.grad_theta)
+    return abs(dEdphi + st.machin * s.rot_drag[0] * frame.omega)
+
+
+def motor_verdict(motor, config, res) -> dict:
+    """Can the torque motor ``motor`` (a :class:`~flagwrap.params.Motor` of kind "torque" or
+    "torque-speed") turn this filament past its threshold?
+
+    The steady whirl at the threshold needs the torque ``T_c`` (:func:`whirl_torque`) at the
+    rate ``f_c``, and its load grows with the rate. A motor whose torque at ``f_c`` exceeds
+    ``T_c`` settles beyond ``f_c`` and buckles the filament; one below it settles short of it.
+    A torque-speed line ``T_s (1 - f/f_0)`` gives ``T_s (1 - f_c/f_0)`` at ``f_c``, so it
+    needs ``T_s > T_c / (1 - f_c / f_0)``; a constant torque needs ``T > T_c``. ``T_c`` is the
+    same at every viscosity (it is ``A/L`` times a function of ``M``), so more viscous fluid
+    lowers ``f_c`` and the stall torque needed, towards ``T_c``. SI: N m and Hz."""
+    out = {"kind": motor.kind, "stall_torque": motor.stall_torque,
+           "zero_load_speed": motor.zero_load_speed, "frequency_c": res.frequency_c}
+    if not res.converged:
+        return {**out, "buckles": None}
+    fil = config.filament
+    T_c = whirl_torque(res) * fil.bending_modulus / fil.length
+    if motor.kind == "torque-speed":
+        slack = 1.0 - res.frequency_c / motor.zero_load_speed
+        available = motor.stall_torque * max(slack, 0.0)
+        needed = T_c / slack if slack > 0 else math.inf
+    else:
+        available, needed = motor.stall_torque, T_c
+    return {**out, "torque_c": T_c, "torque_available": available,
+            "stall_torque_needed": needed, "buckles": bool(available > T_c)}
