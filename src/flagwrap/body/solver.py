@@ -62,7 +62,7 @@ class DirectBlobSolver:
 
     def solve(self, r: np.ndarray) -> np.ndarray:
         """``M_bb^-1 r`` (r: (3n,) or (3n, k)). One right-hand side: BLAS symv, which reads one
-        triangle of the symmetric inverse (1410 unknowns: 0.28 ms against gemv's 0.76)."""
+        triangle of the symmetric inverse (374 blobs: 0.12 ms against gemv's 0.23)."""
         if self._inv is not None:
             if r.ndim == 1:
                 return _symv(1.0, self._inv_f, r, lower=1)

@@ -150,7 +150,7 @@ class SwimmerSystem:
         from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
 
         x, _, _ = s.unpack(yin)
-        xf = np.ascontiguousarray(x[s.nc:])
+        xf = np.array(x[s.nc:])  # a copy: kept with the cache, never a view of the caller's y
         e = x[s.ec + 1:] - x[s.ec:-1]
         t = e / np.linalg.norm(e, axis=1)[:, None]
         rpy_cross_radii(xf, s.radius, self.blobs, self.blob_radii, self._cross)
