@@ -120,6 +120,24 @@ def test_mobility_matrix_is_the_map_and_symmetric_positive(swimmer, rng):
     assert ev[0] > -1e-12 * ev[-1]  # positive semidefinite (the motor angle's row is zero)
 
 
+def test_cached_geometry_gives_the_fresh_systems_velocities(rng):
+    # the swimmer keeps its last bead-blob block; velocities asked at y1, y2, y1 again (and
+    # at y1 after the caller changed its array in place) must be a fresh system's, and the
+    # stage solver's reusing A the same as a fresh one
+    s, fresh = make_swimmer(swimmer_config()), make_swimmer(swimmer_config())
+    (y1, i1), (y2, i2) = perturbed_state(s, rng), perturbed_state(s, rng)
+    ref1 = fresh.apply_mobility(y1, i1.G)
+    ref2 = make_swimmer(swimmer_config()).apply_mobility(y2, i2.G)
+    for y, info, ref in ((y1, i1, ref1), (y2, i2, ref2), (y1, i1, ref1)):
+        assert np.array_equal(s.apply_mobility(y, info.G), ref)
+    y = y1.copy()
+    s.apply_mobility(y, i1.G)
+    y[s.sl_x] += 1e-3  # in place: the cache must not see its old state through a view
+    assert np.array_equal(s.apply_mobility(y1.copy(), i1.G), ref1)
+    A = s.mobility_matrix(y1, screening=False, reuse=True)
+    assert np.array_equal(A, fresh.mobility_matrix(y1, screening=False))
+
+
 def test_quaternion_kinematics_turn_about_a_fixed_axis():
     # dq/dt = q (0, Omega)/2 at constant Omega integrates to the rotation by |Omega| t
     from scipy.integrate import solve_ivp
