@@ -155,8 +155,9 @@ def run(args) -> int:
         print(f"crossing: steady (real eigenvalue {lam.real:+.2e} omega at M = {hi:.2f}): a new "
               f"steadily turning shape branches off")
     tip = res.state.info.x[-1, 2] if res.state is not None else math.nan
+    scale, unit = (1e3, "mm") if L >= 1e-3 else (1e6, "um")  # the rig's helix or a bacterium's
     print(f"steady shape at M_c: free end {(tip - res.tip_z0):+.4f} L above its rest height "
-          f"({(tip - res.tip_z0) * L * 1e3:+.3g} mm)")
+          f"({(tip - res.tip_z0) * L * scale:+.3g} {unit})")
     print(f"M_c / scaling line 0.06 (R/L)^-3 = {res.machin_c / cfg.machin_critical_scaling:.2f}")
     if res.motor is not None:
         print(_motor_line(res.motor))
