@@ -89,13 +89,14 @@ def quaternion_matrix(q) -> np.ndarray:
     """Rotation matrix of the quaternion ``q = (w, x, y, z)`` (normalised here); ``q`` of shape
     (..., 4) gives (..., 3, 3) (a free body's orientation, one or every frame)."""
     q = np.asarray(q, float)
-    if q.ndim == 1:  # one pose (a swimmer's every velocity): the same entries without stacking
-        w, x, y, z = (q / math.sqrt(q @ q)).tolist()
-        return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-    w, x, y, z = np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+    if q.ndim == 1:  # one pose (a swimmer's every velocity): floats, without stacking
+        return np.array(_quaternion_rows(*(q / math.sqrt(q @ q)).tolist()))
+    rows = _quaternion_rows(*np.moveaxis(q / np.linalg.norm(q, axis=-1, keepdims=True), -1, 0))
+    return np.stack([np.stack(row, -1) for row in rows], -2)
+
+
+def _quaternion_rows(w, x, y, z):
+    """The rotation matrix's rows for the unit quaternion ``(w, x, y, z)`` (scalars or arrays)."""
+    return ((1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+            (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+            (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)))

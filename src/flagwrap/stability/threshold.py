@@ -288,8 +288,8 @@ def whirl_torque(res) -> float:
         return math.nan
     frame, st = res.frame, res.state
     s = frame.system
-    dEdphi = s.clamp.generalized_force(0.0, st.info.grad_x, st.info.grad_theta)
-    return abs(dEdphi + st.machin * s.rot_drag[0] * frame.omega)
+    # the system's own torque balance; its drag term M zeta omega taken at the state's M
+    return abs(s.motor_torque(st.info, 0.0, frame.omega * st.machin / s.machin))
 
 
 def motor_verdict(motor, config, res) -> dict:

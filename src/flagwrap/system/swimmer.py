@@ -49,19 +49,8 @@ import scipy.linalg as sla
 from flagwrap.body.multiblob import geometric_matrix
 from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.system.layout import DofLayout
-from flagwrap.system.rotating import RotatingFrame, check_rotating_frame, subtract_rotation
-
-
-def _cross_rows(a, b) -> np.ndarray:
-    """``a x b`` row by row, ``a`` (n, 3) or (3,), ``b`` (n, 3): numpy's formula without its
-    axis handling, which costs more than the products at a swimmer's every velocity."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
-    out = np.empty(b.shape)
-    out[:, 0] = a1 * b2 - a2 * b1
-    out[:, 1] = a2 * b0 - a0 * b2
-    out[:, 2] = a0 * b1 - a1 * b0
-    return out
+from flagwrap.system.rotating import (RotatingFrame, check_rotating_frame, cross_matrix,
+                                      subtract_rotation)
 
 
 def quaternion_rate(q, omega_body) -> np.ndarray:
@@ -160,7 +149,9 @@ class SwimmerSystem:
 
     def _load(self, xf, t, F, tau) -> np.ndarray:
         """``S G = [sum F; sum x x F + sum tau t]`` (6,)."""
-        return np.concatenate([F.sum(axis=0), _cross_rows(xf, F).sum(axis=0) + tau @ t])
+        XF = xf.T @ F  # sum x x F is its antisymmetric part (np.cross costs more than this)
+        torque = np.array([XF[1, 2] - XF[2, 1], XF[2, 0] - XF[0, 2], XF[0, 1] - XF[1, 0]])
+        return np.concatenate([F.sum(axis=0), torque + tau @ t])
 
     def body_velocity(self, y, G) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(V, v_beads, lambda)``: the body's ``[U; Omega]`` (body axes, core units), the free
@@ -187,7 +178,7 @@ class SwimmerSystem:
         V, v, _, xf, t = self._solve(y, G)
         U, Om = V[:3], V[3:]
         out = np.zeros(self.ny)
-        out[s.sl_x] = (v - U - _cross_rows(Om, xf)).ravel()
+        out[s.sl_x] = (v - U - xf @ cross_matrix(Om).T).ravel()
         out[s.sl_th] = s.twist_mobility * G[s.sl_th] - t @ Om
         q = y[self.sl_q] / np.linalg.norm(y[self.sl_q])
         out[self.sl_X] = quaternion_matrix(q) @ U
@@ -234,11 +225,7 @@ class SwimmerSystem:
         # - S: the beads' rigid-motion matrix transposed, [I; [x]_x] per bead; [0; t] per bond
         D[:, :n3] = (C @ self._MinvK).T - geometric_matrix(xf).T
         D[3:, n3:n3 + s.ne] -= t.T
-        ND = self.body_mobility @ D
-        if tmp is None:
-            A += D.T @ ND
-        else:
-            A += np.matmul(D.T, ND, out=tmp)
+        A += np.matmul(D.T, self.body_mobility @ D, out=tmp)
         A /= s.machin
         return A
 
