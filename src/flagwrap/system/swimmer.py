@@ -264,21 +264,24 @@ class SwimmerW:
 
     def __init__(self, system, y, base, G0, gamma_h, omega=None):
         from flagwrap.integrators.linear import SingularW
+        from flagwrap.system.kernels import w_transpose_dense_full
 
         n = system.n_in
         inner = system.inner
-        J = inner.force_jacobian_sparse(y[:n], base, G0[:n])
+        rows, cols, vals = inner.force_jacobian_coo(y[:n], base, G0[:n])
         motor = inner.motor_jacobian(y[:n], base, omega)  # a torque motor's row, else None
-        # A J with J sparse (~20 entries a column), as (J^T A^T)^T
-        W = np.asarray((J.T @ system.mobility_matrix(y, screening=False, reuse=True)).T)
-        W *= -gamma_h
-        W.flat[::n + 1] += 1.0
+        A = system.mobility_matrix(y, screening=False, reuse=True)
+        # W^T in C order is W in Fortran order: LAPACK factorises it in place (as DenseW)
+        WT = system.__dict__.get("_wt_buffer")
+        if WT is None or WT.shape != (n, n):
+            WT = system._wt_buffer = np.empty((n, n))
+        w_transpose_dense_full(rows, cols, vals, A, gamma_h, WT)
         if motor is not None:
-            W[inner.i_phi] = -gamma_h * motor
-            W[inner.i_phi, inner.i_phi] += 1.0
+            WT[:, inner.i_phi] = -gamma_h * motor
+            WT[inner.i_phi, inner.i_phi] += 1.0
         self.n = n
         try:
-            self.lu = sla.lu_factor(W, overwrite_a=True, check_finite=False)
+            self.lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
         except (ValueError, np.linalg.LinAlgError) as exc:
             raise SingularW(str(exc)) from None
         if not np.all(np.isfinite(self.lu[0])):
