@@ -206,6 +206,13 @@ class FixedBodyMobility:
         M -= self.screening(x)
         return M
 
+    def stage_matrix(self, x, out=None):
+        """The free-space matrix ``M_ff``, for the stage solver's ``W`` only: the screening
+        costs a triangular solve with every bead as right-hand side, and it is smooth, so the
+        stiff local modes the W must damp hardly see it (the free swimmer's ``W`` leaves it out
+        for the same reason: :meth:`~flagwrap.system.swimmer.SwimmerSystem.mobility_matrix`)."""
+        return self._free.matrix(x, out=out)
+
     def near_field_blocks(self, x, width: int):
         return self._free.near_field_blocks(x, width)
 

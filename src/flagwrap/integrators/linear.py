@@ -49,7 +49,7 @@ class DenseW:
         from flagwrap.system.kernels import w_transpose_dense
 
         rows, cols, vals = system.force_jacobian_coo(y, base, G0)
-        Mxx, mt = system.mobility_blocks(y, reuse=reuse)
+        Mxx, mt = system.mobility_blocks(y, reuse=reuse, stage=True)
         WT = None
         if reuse:  # one W per step: factorise in the system's buffer (no fresh ~0.5 MB array)
             WT = system.__dict__.get("_wt_buffer")
@@ -118,11 +118,11 @@ class KrylovW:
     equal to the true one in exact arithmetic) and, when the integrator passes ``err_scale``
     (the absolute accuracy it holds each unknown to), an estimated solution error
     ``|P^-1 r| <= kappa err_scale`` per unknown with ``kappa = 0.1`` (CVODE likewise solves
-    its Krylov systems to 0.05 x its nonlinear tolerance). Measured on benchmarks/scaling.py's chain: at N = 1000 the residual
-    test alone already gives the steps of exact solves (0.03 turn: 728 steps, 42 ms per
-    step; with both tests 767 steps, 54 ms); at N = 8000 it does not: its solve errors,
-    concentrated where the right-hand side is small, drove the step from ~5e-5 to ~5e-7
-    (1/omega) and the error test restores ~2e-5 (0.0002 turn in 175 steps).
+    its Krylov systems to 0.05 x its nonlinear tolerance). Measured on benchmarks/scaling.py's
+    chain: at N = 1000 the residual test alone already gives the steps of exact solves (0.03
+    turn: 728 steps, 42 ms per step; with both tests 767 steps, 54 ms); at N = 8000 it does
+    not: its solve errors, concentrated where the right-hand side is small, drove the step
+    from ~5e-5 to ~5e-7 (1/omega) and the error test restores ~2e-5 (0.0002 turn in 175 steps).
     """
 
     max_vectors = 40  # ~10-16 directions per step (4 stages) measured; restart when full

@@ -354,18 +354,22 @@ class RodSystem:
         Mb /= self.machin
         return Mb, self.twist_mobility
 
-    def mobility_blocks(self, y: np.ndarray, reuse: bool = False):
+    def mobility_blocks(self, y: np.ndarray, reuse: bool = False, stage: bool = False):
         """``Mob`` as its two non-zero blocks: dense translational (3nb, 3nb), twist diagonal (ne,).
 
         ``reuse``: written into one buffer the system keeps (valid until the next such call):
-        the time loop's dense W, which needs it once per step, then allocates nothing."""
+        the time loop's dense W, which needs it once per step, then allocates nothing.
+        ``stage``: the matrix the stage solver's ``W`` is built from, the mobility's
+        ``stage_matrix`` where it has one (a W-method keeps its order for any ``W``), else
+        the exact one."""
         x, _, _ = self.unpack(y)
         out = None
         if reuse:
             out = self.__dict__.get("_mxx_buffer")
             if out is None:
                 out = self._mxx_buffer = np.empty((3 * self.nb, 3 * self.nb))
-        Mxx = self.mobility.matrix(x[self.nc:], out=out)
+        build = getattr(self.mobility, "stage_matrix", None) if stage else None
+        Mxx = (build or self.mobility.matrix)(x[self.nc:], out=out)
         Mxx /= self.machin
         return Mxx, self.twist_mobility
 
