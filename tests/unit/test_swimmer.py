@@ -364,3 +364,45 @@ def test_rigid_swimmer_speed_converges_with_the_blob_resolution():
     d1, d2 = abs(speeds[1] - speeds[0]), abs(speeds[2] - speeds[1])
     assert d2 < 0.5 * d1
     assert d2 < 0.005 * abs(speeds[2])
+
+
+def test_fixed_no_slip_stage_w_leaves_out_only_the_screening(monkeypatch):
+    # the stage solver's W is built from the free-space matrix (FixedBodyMobility.
+    # stage_matrix), the velocities from the screened one. A W-method keeps its order for any W,
+    # so the run with the exact W (stage_matrix removed) must end where this one does, to the
+    # errors of two tol-controlled runs: 20 tol, under the 25 x tol the shorter one's 25 steps
+    # can add up to (measured 3.7 tol, 36 steps against 25)
+    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.simulation import make_system, simulate
+
+    cfg = swimmer_config(motion="fixed")
+    s = make_system(cfg)
+    x = s.unpack(s.initial_y())[0][s.nc:]
+    Mxx, _ = s.mobility_blocks(s.initial_y(), stage=True)
+    assert np.allclose(Mxx * s.machin, s.mobility._free.matrix(x), rtol=0, atol=1e-14)
+    exact, _ = s.mobility_blocks(s.initial_y())
+    assert np.abs(exact - Mxx).max() > 1e-3 * np.abs(Mxx).max()  # the screening is not nothing
+    approx = simulate(cfg)
+    monkeypatch.delattr(FixedBodyMobility, "stage_matrix")
+    ref = simulate(cfg)
+    assert ref.status == approx.status == "completed"
+    assert np.abs(np.asarray(approx.x[-1]) - np.asarray(ref.x[-1])).max() < 20 * cfg.numerics.tol
+
+
+def test_swimmer_w_from_triplets_is_the_dense_product(swimmer, rng):
+    # W^T = (I - gamma h A J)^T from the Jacobian's COO triplets (duplicates add) against the
+    # dense product: the same sums in another order, so rounding (1e-12 of the largest entry)
+    import scipy.sparse as sp
+
+    from flagwrap.system.kernels import w_transpose_dense_full
+
+    s = swimmer
+    y, info = perturbed_state(s, rng)
+    n = s.n_in
+    rows, cols, vals = s.inner.force_jacobian_coo(y[:n], s.frames0, info.G[:n])
+    A = s.mobility_matrix(y, screening=False)
+    WT = np.empty((n, n))
+    w_transpose_dense_full(rows, cols, vals, A, 0.3, WT)
+    J = sp.coo_matrix((vals, (rows, cols)), shape=(n, n)).toarray()
+    W = np.eye(n) - 0.3 * A @ J
+    assert np.abs(WT.T - W).max() < 1e-12 * np.abs(W).max()
