@@ -114,3 +114,22 @@ def test_species_without_a_pitch_is_refused_by_name():
     sp = next(s for s in default_species() if s.key == "c_insecticola_coil")
     with pytest.raises(UserInputError, match="c_insecticola_coil.*pitch_um"):
         species_config(sp)
+
+
+def test_c_insecticola_example_is_the_data_files_coil(species):
+    # the example's sourced numbers are the data file's (so they cannot drift apart), its bundle
+    # stiffness is n A_1, its M is the one `flagwrap bacteria` prints, and its assumed cell fits
+    # inside the coil it wraps with (radius below R - a) and below the ~1 um channel it passes
+    from flagwrap.io.config import load_config
+
+    s = species["c_insecticola_coil"]
+    cfg = load_config("examples/c_insecticola.toml")
+    f = cfg.filament
+    assert f.length == pytest.approx(s.length_um * 1e-6, rel=1e-12)
+    assert f.helix_radius == pytest.approx(s.radius_um * 1e-6, rel=1e-12)
+    assert f.bending_modulus == pytest.approx(s.bending_stiffness, rel=1e-12)
+    assert cfg.fluid.viscosity == pytest.approx(s.viscosity_pa_s, rel=1e-12)
+    assert cfg.machin == pytest.approx(s.machin, rel=1e-9)
+    assert f.handedness == "left"
+    assert cfg.body.radius < f.helix_radius - f.cross_section_radius
+    assert 2 * cfg.body.radius < 1e-6
