@@ -465,7 +465,8 @@ class RodSystem:
         return J
 
     def force_jacobian_sparse(self, y, base, G0=None, delta: float | None = None):
-        """``dG/dy`` as a scipy CSR matrix (for the matrix-free large-N path)."""
+        """``dG/dy`` as a scipy CSR matrix, from :meth:`force_jacobian_coo` (the stage solvers
+        take the triplets themselves; this is the API's sparse view of them)."""
         import scipy.sparse as sp
 
         rows, cols, vals = self.force_jacobian_coo(y, base, G0, delta)
