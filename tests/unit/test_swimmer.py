@@ -394,7 +394,7 @@ def test_swimmer_w_from_triplets_is_the_dense_product(swimmer, rng):
     # dense product: the same sums in another order, so rounding (1e-12 of the largest entry)
     import scipy.sparse as sp
 
-    from flagwrap.system.kernels import w_transpose_dense_full
+    from flagwrap.system.kernels import w_transpose_dense
 
     s = swimmer
     y, info = perturbed_state(s, rng)
@@ -402,7 +402,7 @@ def test_swimmer_w_from_triplets_is_the_dense_product(swimmer, rng):
     rows, cols, vals = s.inner.force_jacobian_coo(y[:n], s.frames0, info.G[:n])
     A = s.mobility_matrix(y, screening=False)
     WT = np.empty((n, n))
-    w_transpose_dense_full(rows, cols, vals, A, 0.3, WT)
+    w_transpose_dense(rows, cols, vals, A, np.empty(0), 0.3, WT)
     J = sp.coo_matrix((vals, (rows, cols)), shape=(n, n)).toarray()
     W = np.eye(n) - 0.3 * A @ J
     assert np.abs(WT.T - W).max() < 1e-12 * np.abs(W).max()

@@ -243,7 +243,9 @@ def w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT):
     ``Mob = blockdiag(Mxx, diag(mt), 0)`` (translations, twists, motor angle). Each triplet
     ``J[r, c] = v`` adds ``-gamma h Mob[:, r] v`` to column ``c`` of W, i.e. to row ``c`` of
     ``W^T``, a contiguous write (``Mxx`` is symmetric, so its row ``r`` is its column).
-    O(nnz(J) * 3 nb) instead of the dense product's O(ny^3).
+    O(nnz(J) * 3 nb) instead of the dense product's O(ny^3). The free swimmer's dense
+    symmetric ``A`` over all its unknowns is the case ``Mxx = A``, ``mt`` empty
+    (:class:`~flagwrap.system.swimmer.SwimmerW`).
     """
     n3 = Mxx.shape[0]
     ne = mt.shape[0]
@@ -261,20 +263,3 @@ def w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT):
     for i in range(ny):
         WT[i, i] += 1.0
 
-
-@nb.njit(cache=True)
-def w_transpose_dense_full(rows, cols, vals, A, gamma_h, WT):
-    """``WT = (I - gamma h A J)^T`` for a dense symmetric mobility ``A`` over all the unknowns
-    (the free swimmer's, :class:`~flagwrap.system.swimmer.SwimmerW`), from the Jacobian
-    triplets as :func:`w_transpose_dense`: each ``J[r, c] = v`` adds ``-gamma h v A[r, :]`` to
-    row ``c`` of ``W^T``, O(nnz(J) n) with contiguous reads and writes."""
-    n = WT.shape[0]
-    WT[:, :] = 0.0
-    for q in range(rows.shape[0]):
-        r = rows[q]
-        c = cols[q]
-        v = -gamma_h * vals[q]
-        for i in range(n):
-            WT[c, i] += A[r, i] * v
-    for i in range(n):
-        WT[i, i] += 1.0

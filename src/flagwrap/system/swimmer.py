@@ -259,12 +259,15 @@ class SwimmerSystem:
         return np.concatenate([X, q, R @ V[:3], R @ V[3:]])
 
 
+_NO_TWIST_BLOCK = np.empty(0)
+
+
 class SwimmerW:
     """Dense LU of the swimmer's ``W`` (:meth:`SwimmerSystem.make_w`)."""
 
     def __init__(self, system, y, base, G0, gamma_h, omega=None):
         from flagwrap.integrators.linear import SingularW
-        from flagwrap.system.kernels import w_transpose_dense_full
+        from flagwrap.system.kernels import w_transpose_dense
 
         n = system.n_in
         inner = system.inner
@@ -275,7 +278,7 @@ class SwimmerW:
         WT = system.__dict__.get("_wt_buffer")
         if WT is None or WT.shape != (n, n):
             WT = system._wt_buffer = np.empty((n, n))
-        w_transpose_dense_full(rows, cols, vals, A, gamma_h, WT)
+        w_transpose_dense(rows, cols, vals, A, _NO_TWIST_BLOCK, gamma_h, WT)  # Mob = A whole
         if motor is not None:
             WT[:, inner.i_phi] = -gamma_h * motor
             WT[inner.i_phi, inner.i_phi] += 1.0
