@@ -263,7 +263,9 @@ _NO_TWIST_BLOCK = np.empty(0)
 
 
 class SwimmerW:
-    """Dense LU of the swimmer's ``W`` (:meth:`SwimmerSystem.make_w`)."""
+    """Dense LU of the swimmer's ``W`` (:meth:`SwimmerSystem.make_w`), factorised in a buffer
+    the system keeps (as :class:`~flagwrap.integrators.linear.DenseW` with ``reuse``): valid
+    until the next ``SwimmerW`` of the same system, one per step."""
 
     def __init__(self, system, y, base, G0, gamma_h, omega=None):
         from flagwrap.integrators.linear import SingularW
