@@ -60,15 +60,22 @@ class DenseW:
         w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT)
         if system.drive.free:
             add_motor_rows(WT, system, y, base, gamma_h, omega)
-        try:
-            self.lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
-        except (ValueError, np.linalg.LinAlgError) as exc:
-            raise SingularW(str(exc)) from None
-        if not np.all(np.isfinite(self.lu[0])):
-            raise SingularW("non-finite LU")
+        self.lu = lu_of_transpose(WT)
 
     def solve(self, rhs):
         return sla.lu_solve(self.lu, rhs, check_finite=False)
+
+
+def lu_of_transpose(WT):
+    """LU factors of ``W`` given ``WT = W^T`` in C order (``W`` in Fortran order, factorised in
+    place); :class:`SingularW` if LAPACK refuses it or the factors are not finite."""
+    try:
+        lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise SingularW(str(exc)) from None
+    if not np.all(np.isfinite(lu[0])):
+        raise SingularW("non-finite LU")
+    return lu
 
 
 def add_motor_rows(WT, system, y, base, gamma_h, omega) -> None:

@@ -262,4 +262,3 @@ def w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT):
             WT[c, r] += mt[r - n3] * v
     for i in range(ny):
         WT[i, i] += 1.0
-

@@ -268,29 +268,21 @@ class SwimmerW:
     until the next ``SwimmerW`` of the same system, one per step."""
 
     def __init__(self, system, y, base, G0, gamma_h, omega=None):
-        from flagwrap.integrators.linear import SingularW
+        from flagwrap.integrators.linear import add_motor_rows, lu_of_transpose
         from flagwrap.system.kernels import w_transpose_dense
 
         n = system.n_in
         inner = system.inner
         rows, cols, vals = inner.force_jacobian_coo(y[:n], base, G0[:n])
-        motor = inner.motor_jacobian(y[:n], base, omega)  # a torque motor's row, else None
         A = system.mobility_matrix(y, screening=False, reuse=True)
-        # W^T in C order is W in Fortran order: LAPACK factorises it in place (as DenseW)
         WT = system.__dict__.get("_wt_buffer")
-        if WT is None or WT.shape != (n, n):
+        if WT is None:
             WT = system._wt_buffer = np.empty((n, n))
         w_transpose_dense(rows, cols, vals, A, _NO_TWIST_BLOCK, gamma_h, WT)  # Mob = A whole
-        if motor is not None:
-            WT[:, inner.i_phi] = -gamma_h * motor
-            WT[inner.i_phi, inner.i_phi] += 1.0
+        if inner.drive.free:  # a torque motor's row, as the rig's DenseW
+            add_motor_rows(WT, inner, y[:n], base, gamma_h, omega)
         self.n = n
-        try:
-            self.lu = sla.lu_factor(WT.T, overwrite_a=True, check_finite=False)
-        except (ValueError, np.linalg.LinAlgError) as exc:
-            raise SingularW(str(exc)) from None
-        if not np.all(np.isfinite(self.lu[0])):
-            raise SingularW("non-finite LU")
+        self.lu = lu_of_transpose(WT)
 
     def solve(self, rhs):
         out = np.array(rhs, float)
