@@ -15,6 +15,13 @@ a 0.01-turn run of every case has compiled and loaded the kernels:
 Prints steps, rejected steps, seconds and ``ratio`` = seconds / the reference's seconds.
 The issue's target: one turn of the free swimmer under 10x one turn of Fig. 4(a).
 
+``--accuracy``: for the no-slip cases, the global error of the tol 1e-5 run over ``T`` turns
+against a tol 1e-7 run of the same: the free end's position and the body's [L].
+
+``--refresh R [R ...]``: the S. putrefaciens case over ``T`` turns with the stage solver's
+lagged screening (:class:`flagwrap.body.solver.LaggedScreening`) recomputed at each relative
+move ``R`` (0: every step): steps, seconds and how often it was computed.
+
 ``--memory``: the blob solvers instead (:mod:`flagwrap.body.solver`). For the paper's body at
 spacings giving ~500 to ~4000 blobs, each solver's peak memory (tracemalloc, which sees
 numpy's buffers) over building it and one mobility product for the 61-bead filament
@@ -78,11 +85,59 @@ def memory_table(spacings=(0.038, 0.026, 0.018, 0.0127), solvers=("direct", "kry
             del mob
 
 
+def accuracy_table(turns: float):
+    print("| case | steps tol 1e-5 / 1e-7 | free end error [L] | body position error [L] |")
+    print("|---|---:|---:|---:|")
+    for name, cfg in cases(turns)[1:]:
+        runs = [simulate(cfg.replace(numerics=dataclasses.replace(cfg.numerics, tol=tol)))
+                for tol in (1e-5, 1e-7)]
+        end = [np.asarray(r.x[-1])[-1] for r in runs]
+        body = [np.asarray(r.body)[-1][:3] if len(r.body or ()) else np.zeros(3) for r in runs]
+        print(f"| {name} | {runs[0].n_steps} / {runs[1].n_steps} | "
+              f"{np.linalg.norm(end[0] - end[1]):.1e} | {np.linalg.norm(body[0] - body[1]):.1e} |",
+              flush=True)
+
+
+def refresh_table(turns: float, refreshes):
+    import flagwrap.body.solver as bs
+
+    original = bs.LaggedScreening.__init__
+    name, cfg = cases(turns)[3]
+    simulate(cases(0.01)[3][1])
+    try:
+        for r in refreshes:
+            made = []
+
+            def init(self, solver, blobs, cross, refresh=r):
+                original(self, solver, blobs, cross, refresh)
+                made.append(self)
+
+            bs.LaggedScreening.__init__ = init
+            t0 = time.perf_counter()
+            tr = simulate(cfg)
+            dt = time.perf_counter() - t0
+            print(f"{name}, refresh {r:g}: steps {tr.n_steps} rejected {tr.n_rejected} "
+                  f"{dt:.2f} s, screening computed {sum(m.computed for m in made)} times",
+                  flush=True)
+    finally:
+        bs.LaggedScreening.__init__ = original
+
+
 def main(argv=None):
     p = argparse.ArgumentParser()
     p.add_argument("--turns", type=float, default=1.0)
     p.add_argument("--memory", action="store_true", help="the blob solvers' memory table")
+    p.add_argument("--accuracy", action="store_true", help="global error against tol 1e-7")
+    p.add_argument("--refresh", type=float, nargs="+", help="lagged screening's refresh scan")
     args = p.parse_args(argv)
+    if args.refresh:
+        with threadpool_limits(limits=1):
+            refresh_table(args.turns, args.refresh)
+        return
+    if args.accuracy:
+        with threadpool_limits(limits=1):
+            accuracy_table(args.turns)
+        return
     if args.memory:
         with threadpool_limits(limits=1):
             memory_table()

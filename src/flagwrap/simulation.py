@@ -206,7 +206,8 @@ class Simulation:
             t=t, t_end=t_end, h=h, next_save=next_save, n_steps=traj.n_steps,
             n_rejected=traj.n_rejected, wall_time=wall_time, y=y, base_t=base_in.t,
             base_d1=base_in.d1, base_rt=base_in.rt, records=traj.arrays(),
-            config_toml=self._checkpoint_toml()), self.checkpoint_path)
+            config_toml=self._checkpoint_toml(), solver_memory=self.system.solver_memory()),
+            self.checkpoint_path)
 
     def run(self, t_end: float | None = None, progress: bool = False, y0=None,
             base=None, t0: float = 0.0, resume=None, budget_used=(0, 0.0),
@@ -243,10 +244,13 @@ class Simulation:
             traj.n_steps, traj.n_rejected, wall0 = ck.n_steps, ck.n_rejected, ck.wall_time
             y = ck.y.copy()
             base_in = ck.base()
+            s.restore_solver_memory(ck.solver_memory)
             info = s.forces(y, base_in)
             t0 = t
         else:
             t_end = sched.t_end if t_end is None else t_end
+            if y0 is None:  # a new run: nothing of an earlier one's stage solver carries over
+                s.restore_solver_memory(np.zeros(0))
             y = s.initial_y() if y0 is None else np.array(y0, float)
             base_in = (s.frames0.copy() if base is None else base)
             info = s.forces(y, base_in)

@@ -63,3 +63,29 @@ def test_direct_solver_with_and_without_its_inverse_agree(body, monkeypatch):
     factor = DirectBlobSolver(b, r)
     assert with_inv._inv is not None and factor._inv is None
     assert np.allclose(with_inv.solve(rhs), factor.solve(rhs), rtol=1e-12, atol=0)
+
+
+def test_lagged_screening_recomputes_only_past_its_refresh_distance(body):
+    # the screening is computed at the first call; a bead that moves by less than refresh x
+    # its distance to the nearest blob gets the old matrix (the same object), one that moves
+    # farther a fresh one, equal to the exact screening there
+    from flagwrap.body.solver import LaggedScreening
+    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+
+    b, r = body
+    x = np.array([[0.0, 0.0, -0.05], [0.02, 0.0, -0.1], [0.0, 0.03, -0.2]])
+    mob = FixedBodyMobility(0.01, b, r)
+    lag = LaggedScreening(mob._solver, b, mob._cross, refresh=0.3)
+    d = np.min(np.linalg.norm(x[:, None] - b[None], axis=2), axis=1)
+    S0 = lag(x)
+    assert lag.computed == 1 and np.allclose(S0, mob.screening(x), rtol=1e-13, atol=0)
+    near = x.copy()
+    near[0, 0] += 0.29 * d[0]
+    assert lag(near) is S0 and lag.computed == 1
+    far = x.copy()
+    far[2, 1] += 0.31 * d[2]
+    S1 = lag(far)
+    assert lag.computed == 2 and np.allclose(S1, mob.screening(far), rtol=1e-13, atol=0)
+    assert np.abs(S1 - S0).max() > 0  # the beads moved, so the screening did
+    with pytest.raises(ValueError, match="refresh"):
+        LaggedScreening(mob._solver, b, mob._cross, refresh=-1.0)

@@ -178,7 +178,7 @@ class FixedBodyMobility:
     axisymmetric = False
 
     def __init__(self, radius: float, blobs, blob_radii, solver: str = "direct"):
-        from flagwrap.body.solver import make_blob_solver
+        from flagwrap.body.solver import LaggedScreening, make_blob_solver
         from flagwrap.hydrodynamics.mobility import RPYMobility
 
         self.radius = float(radius)
@@ -188,6 +188,7 @@ class FixedBodyMobility:
                                                dtype=np.float64)
         self._free = RPYMobility(self.radius)
         self._solver = make_blob_solver(solver, self.blobs, self.blob_radii)
+        self._lagged = LaggedScreening(self._solver, self.blobs, self._cross)
 
     def _cross(self, x):
         out = np.empty((3 * len(x), 3 * len(self.blobs)))
@@ -207,13 +208,20 @@ class FixedBodyMobility:
         return M
 
     def stage_matrix(self, x, out=None):
-        """The free-space matrix ``M_ff``, for the stage solver's ``W`` only (a W-method keeps
-        its order for any ``W``): the screening costs a triangular solve with every bead as
-        right-hand side. Measured on one turn of Fig. 4(a) (docs/bacterium.md, "Cost and
-        accuracy"): 2020 steps against the exact W's 1083, 1.8x faster at the same tol and
-        ~1.4x at equal accuracy. The free swimmer's ``W`` leaves it out too
-        (:meth:`~flagwrap.system.swimmer.SwimmerSystem.mobility_matrix`)."""
-        return self._free.matrix(x, out=out)
+        """The matrix for the stage solver's ``W`` only (a W-method keeps its order for any
+        ``W``): ``M_ff`` less the screening as last computed, recomputed when the beads have
+        moved (:class:`~flagwrap.body.solver.LaggedScreening`)."""
+        M = self._free.matrix(x, out=out)
+        M -= self._lagged(np.ascontiguousarray(x, dtype=np.float64))
+        return M
+
+    def solver_memory(self) -> np.ndarray:
+        """What :meth:`stage_matrix` carries from step to step
+        (:meth:`~flagwrap.body.solver.LaggedScreening.memory`)."""
+        return self._lagged.memory()
+
+    def restore_solver_memory(self, memory) -> None:
+        self._lagged.restore(memory)
 
     def near_field_blocks(self, x, width: int):
         return self._free.near_field_blocks(x, width)

@@ -15,6 +15,8 @@ attrs ``t_end``            end of the run
 attrs ``n_steps, ...``     accepted / rejected step counters, wall time so far
 ``records/<name>``         the trajectory recorded so far (:meth:`Trajectory.arrays` names; a free
                            body's ``body`` record when the run has one)
+``solver_memory``          what the stage solver carries from step to step (a no-slip body's
+                           lagged screening: ``RodSystem.solver_memory``); empty for the rig
 attrs ``config_toml``      the full input; resume refuses a different one
 attrs ``flagwrap_version`` resume refuses a checkpoint from another version
 =========================  ====================================================================
@@ -26,7 +28,7 @@ written to a temporary name in the same folder, fsynced and renamed, so a crash 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -35,8 +37,9 @@ from flagwrap import __version__
 from flagwrap.errors import UserInputError
 from flagwrap.io.atomic import atomic_write
 
-#: 2: the joint records (hook_angle, hook_torque, hook_twist_torque) and interaction_energy
-CHECKPOINT_FORMAT = 2
+#: 2: the joint records (hook_angle, hook_torque, hook_twist_torque) and interaction_energy;
+#: 3: solver_memory
+CHECKPOINT_FORMAT = 3
 _MAGIC = "flagwrap checkpoint"
 #: the per-frame records of a trajectory (flagwrap.simulation._RECORDS, repeated here so that
 #: reading a checkpoint does not import the simulator; tests/unit/test_checkpoint.py checks)
@@ -66,6 +69,7 @@ class Checkpoint:
     base_rt: np.ndarray
     records: dict
     config_toml: str
+    solver_memory: np.ndarray = field(default_factory=lambda: np.zeros(0))
     flagwrap_version: str = __version__
 
     def base(self):
@@ -95,7 +99,7 @@ def write_checkpoint(ckpt: Checkpoint, path) -> Path:
             # every array carries HDF5's Fletcher-32 checksum, verified by h5py on read; the
             # scalars are also stored as one checksummed array and compared with the attributes
             _checked(f, "scalars", [float(getattr(ckpt, k)) for k in _SCALARS])
-            for k in ("y", "base_t", "base_d1", "base_rt"):
+            for k in ("y", "base_t", "base_d1", "base_rt", "solver_memory"):
                 _checked(f, k, getattr(ckpt, k))
             g = f.create_group("records")
             for k in RECORD_NAMES + tuple(k for k in OPTIONAL_RECORD_NAMES if k in ckpt.records):
@@ -126,7 +130,7 @@ def read_checkpoint(path) -> Checkpoint:
             kw = {k: typ(f.attrs[k]) for k, typ in _SCALARS.items()}
             kw["config_toml"] = str(f.attrs["config_toml"])
             kw["flagwrap_version"] = str(f.attrs["flagwrap_version"])
-            for k in ("y", "base_t", "base_d1", "base_rt"):
+            for k in ("y", "base_t", "base_d1", "base_rt", "solver_memory"):
                 kw[k] = np.array(f[k][()], dtype=np.float64)
             kw["records"] = {k: np.array(f["records"][k][()], dtype=np.float64)
                              for k in RECORD_NAMES + OPTIONAL_RECORD_NAMES

@@ -262,3 +262,18 @@ def w_transpose_dense(rows, cols, vals, Mxx, mt, gamma_h, WT):
             WT[c, r] += mt[r - n3] * v
     for i in range(ny):
         WT[i, i] += 1.0
+
+
+@nb.njit(cache=True)
+def left_product_coo(P, rows, cols, vals, out):
+    """``out = P J`` for ``J`` given by its triplets (duplicates add): O(nnz(J) rows(P)),
+    where a dense ``J`` would make it O(rows(P) n^2)."""
+    out[:, :] = 0.0
+    for q in range(rows.shape[0]):
+        r = rows[q]
+        c = cols[q]
+        v = vals[q]
+        for i in range(P.shape[0]):
+            out[i, c] += P[i, r] * v
+    return out
+

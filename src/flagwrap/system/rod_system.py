@@ -373,6 +373,21 @@ class RodSystem:
         Mxx /= self.machin
         return Mxx, self.twist_mobility
 
+    def solver_memory(self) -> np.ndarray:
+        """What the stage solver carries from one step to the next (a fixed no-slip body's
+        lagged screening: :meth:`~flagwrap.body.solver.LaggedScreening.memory`), flattened;
+        empty where it carries nothing. Checkpoints keep it."""
+        get = getattr(self.mobility, "solver_memory", None)
+        return get() if get else np.zeros(0)
+
+    def restore_solver_memory(self, memory) -> None:
+        """Continue from :meth:`solver_memory` (empty: start afresh)."""
+        restore = getattr(self.mobility, "restore_solver_memory", None)
+        if restore:
+            restore(memory)
+        elif np.size(memory):
+            raise ValueError("this system's stage solver carries no memory to restore")
+
     def mobility_matrix(self, y: np.ndarray) -> np.ndarray:
         """Dense ``Mob(y)`` (ny, ny)."""
         x, _, _ = self.unpack(y)

@@ -36,9 +36,12 @@ The twist torques act on the fluid locally (the bond's rotational drag), as in t
 The body's pose (lab position ``X`` of its reference point and unit quaternion ``q``, body to
 lab) is carried in ``y`` after the filament's unknowns: ``dX/dt = R(q) U``, ``dq/dt =
 q (0, Omega) / 2``. Nothing depends on the pose (no gravity on a free cell), so the stage
-solver ``W`` is the filament's ``I - gamma h A J`` with the identity on the pose: a W-method
-keeps its order for such a ``W``. Run files are written in the lab frame (:meth:`record_view`)
-and carry the body's pose and velocities (:meth:`body_record`).
+solver ``W`` is block lower triangular: the filament's ``I - gamma h A J`` (:class:`SwimmerW`),
+and the pose's rows ``-gamma h P J`` beside the identity, ``P`` the pose rates per generalized
+force. Those rows matter: the pose is driven by the filament's stiff modes, and without them
+its stages integrate those modes explicitly and the step controller halves the step. Run
+files are written in the lab frame (:meth:`record_view`) and carry the body's pose and
+velocities (:meth:`body_record`).
 """
 
 from __future__ import annotations
@@ -47,10 +50,18 @@ import numpy as np
 import scipy.linalg as sla
 
 from flagwrap.body.multiblob import geometric_matrix
+from flagwrap.body.solver import LaggedScreening
 from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.rotating import (RotatingFrame, check_rotating_frame, cross_matrix,
                                       subtract_rotation)
+
+
+def quaternion_rate_matrix(q) -> np.ndarray:
+    """``Q(q)`` (4, 3) with ``q (0, Omega) = Q(q) Omega``, so that :func:`quaternion_rate` is
+    ``Q(q) Omega / 2``."""
+    w, x, y, z = q
+    return np.array([[-x, -y, -z], [w, -z, y], [z, w, -x], [-y, x, w]])
 
 
 def quaternion_rate(q, omega_body) -> np.ndarray:
@@ -94,6 +105,7 @@ class SwimmerSystem:
         self.sl_X = self.layout["body_x"]
         self.sl_q = self.layout["body_q"]
         self._cross = np.empty((3 * s.nb, 3 * len(self.blobs)))
+        self._lagged = LaggedScreening(self._solver, self.blobs, self._cross_at)
         self._geometry_y = None
         self._a_buffers = None
 
@@ -147,6 +159,23 @@ class SwimmerSystem:
         self._geometry_out = (xf, t, self._cross)
         return self._geometry_out
 
+    def _cross_at(self, xf) -> np.ndarray:
+        """``M_fb`` for free beads at ``xf`` in a new array (the lagged screening's, which
+        must not overwrite the kept geometry's)."""
+        from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
+
+        out = np.empty((3 * len(xf), 3 * len(self.blobs)))
+        rpy_cross_radii(xf, self.inner.radius, self.blobs, self.blob_radii, out)
+        return out
+
+    def solver_memory(self) -> np.ndarray:
+        """What the stage solver carries from step to step: the lagged screening's
+        (:meth:`~flagwrap.body.solver.LaggedScreening.memory`)."""
+        return self._lagged.memory()
+
+    def restore_solver_memory(self, memory) -> None:
+        self._lagged.restore(memory)
+
     def _load(self, xf, t, F, tau) -> np.ndarray:
         """``S G = [sum F; sum x x F + sum tau t]`` (6,)."""
         XF = xf.T @ F  # sum x x F is its antisymmetric part (np.cross costs more than this)
@@ -194,15 +223,16 @@ class SwimmerSystem:
         info = self.forces(y, base)
         return self.velocity(y, info, omega), info
 
-    def mobility_matrix(self, y, screening: bool = True, reuse: bool = False) -> np.ndarray:
+    def mobility_matrix(self, y, screening=True, reuse: bool = False) -> np.ndarray:
         """Dense ``A`` over the filament's unknowns (n_in, n_in; motor-angle row and column 0):
         ``A_fixed + D^T N D``, ``D = E - S``.
 
-        ``screening=False``: without the fixed surface's screening ``M_fb M_bb^-1 M_bf`` (the
-        stage solver's ``W``: that term costs a triangular solve with every bead as right-hand
-        side, ~90 % of a step, and is smooth, so the stiff local modes hardly see it).
+        ``screening``: ``True``, the fixed surface's screening ``M_fb M_bb^-1 M_bf`` exact;
+        ``False`` without it; ``"lagged"`` as last computed, recomputed when the beads have
+        moved (:class:`~flagwrap.body.solver.LaggedScreening`: the stage solver's ``W``).
         ``reuse=True`` (the stage solver, once a step): built in buffers the system keeps, so
-        the result is valid until the next reusing call."""
+        the result is valid until the next reusing call, and the body's rows ``N D`` kept
+        for the pose rows of ``W``."""
         s = self.inner
         xf, t, C = self._geometry(y)
         n3 = 3 * s.nb
@@ -215,7 +245,9 @@ class SwimmerSystem:
         else:
             A, tmp, Mff = np.zeros((self.n_in, self.n_in)), None, None
         A[:n3, :n3] = s.mobility.matrix(xf, out=Mff)
-        if screening:
+        if screening == "lagged":
+            A[:n3, :n3] -= self._lagged(xf)
+        elif screening:
             from flagwrap.body.solver import screening_matrix
 
             A[:n3, :n3] -= screening_matrix(self._solver, C)
@@ -225,16 +257,15 @@ class SwimmerSystem:
         # - S: the beads' rigid-motion matrix transposed, [I; [x]_x] per bead; [0; t] per bond
         D[:, :n3] = (C @ self._MinvK).T - geometric_matrix(xf).T
         D[3:, n3:n3 + s.ne] -= t.T
-        A += np.matmul(D.T, self.body_mobility @ D, out=tmp)
+        ND = self.body_mobility @ D
+        A += np.matmul(D.T, ND, out=tmp)
         A /= s.machin
+        if reuse:  # the body's velocity per generalized force: V = (N D / machin) G
+            self._body_rows = ND / s.machin
         return A
 
     def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
-        """The stage solver: dense LU of ``I - gamma h A J`` on the filament, identity on the
-        pose (module docstring), with ``A`` less the surface's screening
-        (:meth:`mobility_matrix`); every ``kind`` gets it. Measured (docs/bacterium.md):
-        0.3 turn of the 61-bead Fig. 4(a) swimmer takes 537 steps against 506 with the exact
-        ``A``, at half the time per step; the free-space mobility alone (no body term) 567."""
+        """The stage solver (:class:`SwimmerW`); every ``kind`` gets it."""
         return SwimmerW(self, y, base, G0, gamma_h, omega)
 
     # output --------------------------------------------------------------------------------
@@ -263,18 +294,25 @@ _NO_TWIST_BLOCK = np.empty(0)
 
 
 class SwimmerW:
-    """Dense LU of the swimmer's ``W`` (:meth:`SwimmerSystem.make_w`), factorised in a buffer
-    the system keeps (as :class:`~flagwrap.integrators.linear.DenseW` with ``reuse``): valid
-    until the next ``SwimmerW`` of the same system, one per step."""
+    """The swimmer's ``W = I - gamma h (dy/dt)/dy`` without the mobility's own change:
+
+        W = [[I - gamma h A J, 0], [-gamma h P J, I]]
+
+    over (filament, pose); ``A`` with the screening lagged (:meth:`SwimmerSystem.
+    mobility_matrix`), ``J`` the force Jacobian, ``P = [R(q) N_U; Q(q) N_Omega / 2] D /
+    machin`` the pose rates per generalized force (:func:`quaternion_rate_matrix`). A solve is
+    the filament's LU, then the pose rows forward. The filament block's LU is factorised in a
+    buffer the system keeps (as :class:`~flagwrap.integrators.linear.DenseW` with ``reuse``):
+    valid until the next ``SwimmerW`` of the same system, one per step."""
 
     def __init__(self, system, y, base, G0, gamma_h, omega=None):
         from flagwrap.integrators.linear import add_motor_rows, lu_of_transpose
-        from flagwrap.system.kernels import w_transpose_dense
+        from flagwrap.system.kernels import left_product_coo, w_transpose_dense
 
         n = system.n_in
         inner = system.inner
         rows, cols, vals = inner.force_jacobian_coo(y[:n], base, G0[:n])
-        A = system.mobility_matrix(y, screening=False, reuse=True)
+        A = system.mobility_matrix(y, screening="lagged", reuse=True)
         WT = system.__dict__.get("_wt_buffer")
         if WT is None:
             WT = system._wt_buffer = np.empty((n, n))
@@ -283,10 +321,17 @@ class SwimmerW:
             add_motor_rows(WT, inner, y[:n], base, gamma_h, omega)
         self.n = n
         self.lu = lu_of_transpose(WT)
+        q = y[system.sl_q] / np.linalg.norm(y[system.sl_q])
+        ND = system._body_rows
+        P = np.concatenate([quaternion_matrix(q) @ ND[:3],
+                            0.5 * quaternion_rate_matrix(q) @ ND[3:]])
+        self.PJ = left_product_coo(P, rows, cols, vals, np.empty((7, n)))
+        self.PJ *= gamma_h
 
     def solve(self, rhs):
         out = np.array(rhs, float)
-        out[:self.n] = sla.lu_solve(self.lu, rhs[:self.n], check_finite=False)
+        u = out[:self.n] = sla.lu_solve(self.lu, rhs[:self.n], check_finite=False)
+        out[self.n:] += self.PJ @ u
         return out
 
 
