@@ -126,6 +126,23 @@ def test_full_analysis_end_to_end():
     assert np.isnan(stable.summary()["waiting_time_turns"])
 
 
+def test_a_rise_that_comes_back_is_buckled_but_not_sustained():
+    # the hanging helix lifted rigidly: by 0.3 L from 12 T on (a buckle that lasts), or by a
+    # wobble 0.3 L peak to peak (3-turn period, C. insecticola's) decaying to 0.1 L by the
+    # end: both cross 0.15 L for over a turn after the switch, only the first ends above it
+    lift = {"lasting": np.where(T >= 12, 0.3, 0.0),
+            "wobble": np.where(T >= 10, 0.15 * (1 - np.cos(2 * np.pi * (T - 10) / 3))
+                               * np.exp(-(T - 10) / 6), 0.0)}
+    out = {}
+    for name, dz in lift.items():
+        x = np.repeat(hanging()[None], T.size, axis=0)
+        x[:, 1:, 2] += dz[:, None]  # the clamp stays: the free end's height rises by dz
+        out[name] = BucklingAnalysis().compute(T, x, OMEGA, L, RC, H).summary()
+    assert out["lasting"]["buckled"] and out["lasting"]["sustained"]
+    assert out["wobble"]["buckled"] and not out["wobble"]["sustained"]
+    assert out["wobble"]["final_height"] - out["wobble"]["baseline_height"] < 0.15
+
+
 def test_baseline_is_the_relaxed_ccw_state_even_with_a_stop_phase_before_cw():
     # CCW to 10 T (the free end relaxes from -0.55 to -0.35 L), stop to 12 T, then CW with
     # no change: not buckled. A baseline window ending at the switch saw only the stop phase

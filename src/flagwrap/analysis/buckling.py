@@ -522,15 +522,20 @@ class BucklingAnalysis(_Compute):
         """Scalar results (JSON-serialisable; nan where undefined)."""
         self._need()
         w, f = self.waiting, self.final
+        final_height = plateau_value(w._turns, self.height, f.final_turns)
         return {
             "state": f.state,
             "buckled": w.buckled,
+            # the rise still there over the final window: a decaying wobble on a soft hook
+            # (docs/bacterium.md, C. insecticola) crosses the threshold for a turn and comes
+            # back; the paper's rule calls it buckled, this says it did not last
+            "sustained": bool(w.buckled and final_height - w.baseline >= w.threshold),
             "switch_turns": w.switch_turns,
             "baseline_height": w.baseline,
             "waiting_time_turns": w.waiting_time,
             "crossing_turns": w.crossing_turns - w.switch_turns,
             "perversion_turns": self.perversion_turns,
-            "final_height": plateau_value(w._turns, self.height, f.final_turns),
+            "final_height": final_height,
             "max_height": float(np.max(self.height[w.switch_index:])),
             "winding_turns": f.winding,
             "contact_fraction": f.contact_fraction,

@@ -35,6 +35,7 @@ def add_arguments(p):
 ROWS = [
     ("state", "final state", "{}"),
     ("buckled", "buckled", "{}"),
+    ("sustained", "rise lasts to the end", "{}"),
     ("switch_turns", "CCW->CW switch t_s/T", "{:.3f}"),
     ("waiting_time_turns", "waiting time t_c/T", "{:.3f}"),
     ("crossing_turns", "threshold crossing (t-t_s)/T", "{:.3f}"),
@@ -96,6 +97,12 @@ def run(args) -> int:
         for key, label, fmt in ROWS:
             v = res[key]
             print(f"  {label:<30s} {fmt.format(v) if not (isinstance(v, float) and v != v) else '-'}")
+        if res["buckled"] and not res["sustained"]:
+            rise = res["final_height"] - res["baseline_height"]
+            print(f"  note: the rise did not last: over the final {args.final_turns:g} turn(s) the "
+                  f"free end is {rise:+.3f} L from its CCW baseline, under the {args.threshold:g} L "
+                  "threshold (a transient, or a decaying wobble on a soft hook); 'buckled' is the "
+                  "paper's rule (docs/analysis.md)")
         for ph in res["swimming"]:  # a free swimmer, phase by phase (second half of each)
             what = "last turns" if ph["direction"] == "final" else f"{ph['direction']} phase"
             print(f"  swimming, {what} ({ph['t0']:.3g}-{ph['t1']:.3g} s): "
