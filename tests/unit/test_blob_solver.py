@@ -89,3 +89,16 @@ def test_lagged_screening_recomputes_only_past_its_refresh_distance(body):
     assert np.abs(S1 - S0).max() > 0  # the beads moved, so the screening did
     with pytest.raises(ValueError, match="refresh"):
         LaggedScreening(mob._solver, b, mob._cross, refresh=-1.0)
+
+
+def test_lagged_screening_stays_out_of_w_with_the_krylov_solver(body):
+    # one screening would be a CG solve per bead coordinate: the Krylov path goes without
+    from flagwrap.body.solver import LaggedScreening
+    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+
+    b, r = body
+    x = np.array([[0.0, 0.0, -0.05], [0.02, 0.0, -0.1]])
+    mob = FixedBodyMobility(0.01, b, r, solver="krylov")
+    lag = LaggedScreening(mob._solver, b, mob._cross)
+    assert lag(x) is None and lag.computed == 0 and lag.memory().size == 0
+    assert np.array_equal(mob.stage_matrix(x), mob._free.matrix(x))

@@ -162,8 +162,13 @@ class LaggedScreening:
     267). Exact, it costs a triangular solve with every bead as right-hand side, ~60 % of a
     step. It varies with a bead's position on the scale of its distance ``d`` to the surface,
     so its relative change since the last computation is about ``max |dx| / d``: ``refresh``
-    bounds that change. Measured (docs/bacterium.md, "Cost and accuracy"): steps and time
-    against ``refresh``."""
+    bounds that change. Measured (docs/bacterium.md, "The stage solver"): steps and time
+    against ``refresh``.
+
+    Only with the direct solver: with conjugate gradients (:class:`KrylovBlobSolver`) one
+    screening is a CG solve per bead coordinate (3n of them, each ~100 O(n_blob^2) products:
+    a minute at 415 blobs, an hour at 4000), so there it returns ``None`` and ``W`` goes
+    without, at twice the steps."""
 
     def __init__(self, solver, blobs, cross, refresh: float = 0.3):
         from scipy.spatial import cKDTree
@@ -177,9 +182,11 @@ class LaggedScreening:
         self._x = None
         self.computed = 0  # how many times it was computed (for the benchmarks)
 
-    def __call__(self, x: np.ndarray) -> np.ndarray:
-        """The screening for the beads at ``x`` (n, 3). The matrix returned is the object's
-        own: read it, never write it."""
+    def __call__(self, x: np.ndarray) -> np.ndarray | None:
+        """The screening for the beads at ``x`` (n, 3), or ``None`` (a Krylov solver). The
+        matrix returned is the object's own: read it, never write it."""
+        if self.solver.kind != "direct":
+            return None
         if self._x is None or x.shape != self._x.shape or np.any(
                 np.linalg.norm(x - self._x, axis=1) > self.refresh * self._d):
             self._compute(np.array(x))
@@ -201,7 +208,7 @@ class LaggedScreening:
         """Continue from :meth:`memory` (empty: start afresh); recomputes the screening there,
         the same numbers as when it was first computed."""
         memory = np.asarray(memory, dtype=np.float64)
-        if memory.size == 0:
+        if memory.size == 0 or self.solver.kind != "direct":
             self._x = None
         else:
             self._compute(memory.reshape(-1, 3).copy())

@@ -210,9 +210,12 @@ class FixedBodyMobility:
     def stage_matrix(self, x, out=None):
         """The matrix for the stage solver's ``W`` only (a W-method keeps its order for any
         ``W``): ``M_ff`` less the screening as last computed, recomputed when the beads have
-        moved (:class:`~flagwrap.body.solver.LaggedScreening`)."""
+        moved (:class:`~flagwrap.body.solver.LaggedScreening`; with the Krylov solver ``M_ff``
+        alone)."""
         M = self._free.matrix(x, out=out)
-        M -= self._lagged(np.ascontiguousarray(x, dtype=np.float64))
+        S = self._lagged(np.ascontiguousarray(x, dtype=np.float64))
+        if S is not None:
+            M -= S
         return M
 
     def solver_memory(self) -> np.ndarray:

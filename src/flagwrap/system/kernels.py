@@ -276,4 +276,3 @@ def left_product_coo(P, rows, cols, vals, out):
         for i in range(P.shape[0]):
             out[i, c] += P[i, r] * v
     return out
-

@@ -246,7 +246,9 @@ class SwimmerSystem:
             A, tmp, Mff = np.zeros((self.n_in, self.n_in)), None, None
         A[:n3, :n3] = s.mobility.matrix(xf, out=Mff)
         if screening == "lagged":
-            A[:n3, :n3] -= self._lagged(xf)
+            S = self._lagged(xf)
+            if S is not None:  # None: a Krylov blob solver, W goes without
+                A[:n3, :n3] -= S
         elif screening:
             from flagwrap.body.solver import screening_matrix
 
