@@ -133,3 +133,18 @@ def test_c_insecticola_example_is_the_data_files_coil(species):
     assert f.handedness == "left"
     assert cfg.body.radius < f.helix_radius - f.cross_section_radius
     assert 2 * cfg.body.radius < 1e-6
+
+
+def test_c_insecticola_torque_speed_example_is_the_example_but_its_motor():
+    # the torque-speed variant brackets the motor (docs/bacterium.md): everything but [motor]
+    # and the name must be the example's, or the comparison between them means nothing
+    from flagwrap.io.config import load_config
+
+    a = load_config("examples/c_insecticola.toml").to_dict()
+    b = load_config("examples/c_insecticola_torque_speed.toml").to_dict()
+    for d in (a, b):
+        d.pop("name")
+        d.pop("motor")
+    assert a == b
+    m = load_config("examples/c_insecticola_torque_speed.toml").motor
+    assert m.kind == "torque-speed" and m.frequency == 40.0
