@@ -141,6 +141,26 @@ def test_swimmer_w_pose_rows_are_the_pose_rates_of_the_force_change(rng):
     assert np.abs(u[n:] - r[n:]).max() > 1e-3 * np.abs(r[n:]).max()  # the rows are not nothing
 
 
+def test_swimmer_w_leaves_the_screening_out_while_a_bead_touches_the_body(rng):
+    # with a bead in the body's contact range (here 1.5 bead radii off the cylinder) the
+    # screened W made the controller alternate accepted and rejected steps (docs/bacterium.md,
+    # "The stage solver"): W's filament block must then be the unscreened one, and the lagged
+    # screening not computed; away from the body it is computed
+    s = make_swimmer(swimmer_config())
+    y, info = perturbed_state(s, rng)
+    s.make_w("dense", y, s.frames0, info.G, 0.05)
+    assert s._lagged.computed == 1
+    k = s.inner.sl_x.start + 3 * 5
+    y[k:k + 3] = [0.125 + 1.5 * s.inner.radius, 0.0, 0.2]
+    info = s.forces(y, s.frames0)
+    assert info.contact_energy > 0
+    fresh = make_swimmer(swimmer_config())
+    fresh.make_w("dense", y, fresh.frames0, info.G, 0.05)
+    assert fresh._lagged.computed == 0
+    A = fresh._a_buffers[0].copy()
+    assert np.array_equal(A, make_swimmer(swimmer_config()).mobility_matrix(y, screening=False))
+
+
 def test_cached_geometry_gives_the_fresh_systems_velocities(rng):
     # the swimmer keeps its last bead-blob block; velocities asked at y1, y2, y1 again (and
     # at y1 after the caller changed its array in place) must be a fresh system's, and the
