@@ -155,6 +155,14 @@ def rpy_cross_radii(x, a, y, b, out):
             out[k + 2, m + 2] = f + g * d2 * d2
 
 
+def rpy_cross_block(x, a, blobs, blob_radii) -> np.ndarray:
+    """:func:`rpy_cross_radii` for beads at ``x`` (radius ``a``) and ``blobs`` in a new
+    (3n, 3m) array."""
+    out = np.empty((3 * len(x), 3 * len(blobs)))
+    rpy_cross_radii(np.ascontiguousarray(x, dtype=np.float64), a, blobs, blob_radii, out)
+    return out
+
+
 class FixedBodyMobility:
     """The beads' mobility beside a fixed body with a no-slip surface (rigid multiblob,
     :mod:`flagwrap.body.multiblob`).
@@ -191,10 +199,7 @@ class FixedBodyMobility:
         self._lagged = LaggedScreening(self._solver, self.blobs, self._cross)
 
     def _cross(self, x):
-        out = np.empty((3 * len(x), 3 * len(self.blobs)))
-        rpy_cross_radii(np.ascontiguousarray(x, dtype=np.float64), self.radius, self.blobs,
-                        self.blob_radii, out)
-        return out
+        return rpy_cross_block(x, self.radius, self.blobs, self.blob_radii)
 
     def screening(self, x) -> np.ndarray:
         """``M_fb M_bb^-1 M_bf`` (3n, 3n): what the body takes off the free mobility."""

@@ -52,6 +52,7 @@ import scipy.linalg as sla
 from flagwrap.body.multiblob import geometric_matrix
 from flagwrap.body.solver import LaggedScreening
 from flagwrap.geometry.frames import quaternion_matrix
+from flagwrap.hydrodynamics.polydisperse import rpy_cross_block
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.rotating import (RotatingFrame, check_rotating_frame, cross_matrix,
                                       subtract_rotation)
@@ -105,7 +106,10 @@ class SwimmerSystem:
         self.sl_X = self.layout["body_x"]
         self.sl_q = self.layout["body_q"]
         self._cross = np.empty((3 * s.nb, 3 * len(self.blobs)))
-        self._lagged = LaggedScreening(self._solver, self.blobs, self._cross_at)
+        # its own M_fb builder: the lagged screening must not overwrite the kept geometry's
+        self._lagged = LaggedScreening(
+            self._solver, self.blobs,
+            lambda xf: rpy_cross_block(xf, system.radius, self.blobs, self.blob_radii))
         self._geometry_y = None
         self._a_buffers = None
 
@@ -158,15 +162,6 @@ class SwimmerSystem:
         self._geometry_y = np.array(yin)
         self._geometry_out = (xf, t, self._cross)
         return self._geometry_out
-
-    def _cross_at(self, xf) -> np.ndarray:
-        """``M_fb`` for free beads at ``xf`` in a new array (the lagged screening's, which
-        must not overwrite the kept geometry's)."""
-        from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
-
-        out = np.empty((3 * len(xf), 3 * len(self.blobs)))
-        rpy_cross_radii(xf, self.inner.radius, self.blobs, self.blob_radii, out)
-        return out
 
     def solver_memory(self) -> np.ndarray:
         """What the stage solver carries from step to step: the lagged screening's
