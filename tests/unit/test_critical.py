@@ -163,22 +163,69 @@ def test_cli_with_fake_runner(tmp_path, cfg, monkeypatch, capsys):
     assert rc == 0 and any(r["waiting_time"] is None for r in res["runs"])
 
 
-def test_chunked_run_equals_full_run(cfg):
-    """Oracle: the uninterrupted simulator. Restarting at chunk edges only resets the step size."""
+def _prefix_of_full_run(cfg, stop_after, every_turns):
+    """The runner's frames against the uninterrupted simulator's (the oracle): the same,
+    bit for bit, up to where the runner stopped."""
     import numpy as np
 
     from flagwrap.analysis.critical import simulate_until_buckled
-    from flagwrap.io.config import config_from_dict
     from flagwrap.simulation import simulate
+
+    a = simulate(cfg)
+    b = simulate_until_buckled(cfg, stop_after=stop_after, chunk_turns=every_turns)
+    assert a.ok and b.ok and 1 < len(b.t) <= len(a.t)
+    n = len(b.t)
+    for k in ("t", "x", "theta", "phi"):
+        assert np.array_equal(np.asarray(getattr(b, k)), np.asarray(getattr(a, k))[:n]), k
+    return a, b
+
+
+def test_runner_equals_the_full_run(cfg):
+    """The checks every 0.5 turn read the trajectory and never restart the integrator."""
+    from flagwrap.io.config import config_from_dict
 
     d = cfg.to_dict()
     d["filament"]["n_beads"] = 21
     small = probe_config(config_from_dict(d), 283.0, ccw_turns=0.5, cw_turns=2.0)
-    a = simulate(small)
-    b = simulate_until_buckled(small, stop_after=2.0, chunk_turns=0.5)
-    assert a.ok and b.ok and len(a.t) == len(b.t)
-    np.testing.assert_allclose(b.t, a.t, atol=1e-12)
-    np.testing.assert_allclose(np.asarray(b.x), np.asarray(a.x), atol=1e-4)
+    a, b = _prefix_of_full_run(small, 2.0, 0.5)
+    assert len(a.t) == len(b.t)  # stable: the whole protocol
+
+
+def test_runner_stops_a_turning_frame_run_off_whole_turns_without_a_jump():
+    """The turning frame (its state is not the lab's ``pack``): checks 0.37 turn apart, a
+    buckling run (M = 1500) stopped early. The re-packing runner of before jumped 0.17 L at
+    such an edge."""
+    import dataclasses
+
+    import numpy as np
+
+    from flagwrap.io.config import config_from_dict
+    from flagwrap.io.config import load_config
+
+    base = load_config("examples/fig4a.toml")
+    d = base.to_dict()
+    d["filament"]["n_beads"] = 21
+    c = probe_config(config_from_dict(d), 1500.0, ccw_turns=1.0, cw_turns=6.0)
+    c = c.replace(numerics=dataclasses.replace(c.numerics, frame="rotating"))
+    a, b = _prefix_of_full_run(c, 0.5, 0.37)
+    assert b.message.startswith("stopped early") and len(b.t) < len(a.t), b.message
+    step = np.abs(np.diff(np.asarray(b.x)[:, -1, :], axis=0)).max()
+    assert step < 0.1  # free end moves < 0.1 L between frames 0.05 T apart: no jump
+
+
+def test_runner_takes_a_free_swimmer_off_whole_turns(tmp_path):
+    """The free swimmer (its state carries the body's pose): the runner of before raised
+    TypeError at its second chunk. Here the default runner (run file + analysis) on it."""
+    import math
+
+    from flagwrap.analysis.critical import simulate_and_analyse
+    from test_swimmer import swimmer_config
+
+    c = swimmer_config(protocol=(("ccw", 0.3), ("cw", 1.6)))
+    _prefix_of_full_run(c, 2.0, 0.37)
+    res = simulate_and_analyse(c, tmp_path / "run.nc")
+    assert res["run_status"] == "completed" and res["buckled"] in (True, False)
+    assert (tmp_path / "run.nc").is_file() and not math.isnan(res["torque_peak_reduced"])
 
 
 def test_failed_run_is_not_called_stable(tmp_path, cfg):

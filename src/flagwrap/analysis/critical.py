@@ -111,13 +111,21 @@ def probe_config(cfg, machin: float, ccw_turns: float = 5.0, cw_turns: float = 1
     return cfg.replace(motor=motor, name=f"{cfg.name}_M{machin:.4g}")
 
 
+#: How the test runs are stepped, hashed into every cached result's key: 1, the CW phase in
+#: chunks restarted from a re-packed state (step sizes restart at each edge); 2, one run
+#: ended by :class:`BuckledStop`. A change of it is a change of the results: they run again.
+RUNNER_REVISION = 2
+
+
 def config_key(cfg, extra: str = "") -> str:
-    """16 hex digits of SHA-256 over the config's TOML text and the flagwrap version, and
-    ``extra`` (whatever else decides the run's result, e.g. a sweep's runner and stop rule)."""
+    """16 hex digits of SHA-256 over the config's TOML text, the flagwrap version, the test
+    runs' :data:`RUNNER_REVISION` and ``extra`` (whatever else decides the run's result, e.g.
+    a sweep's runner and stop rule)."""
     from flagwrap import __version__
     from flagwrap.io.config import config_to_toml
 
-    text = config_to_toml(cfg.replace(name="run"), for_hash=True) + f"\n# flagwrap {__version__}\n"
+    text = (config_to_toml(cfg.replace(name="run"), for_hash=True)
+            + f"\n# flagwrap {__version__}, runner revision {RUNNER_REVISION}\n")
     if extra:
         text += f"# {extra}\n"
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -127,66 +135,34 @@ def simulate_until_buckled(cfg, stop_after: float | None = 2.0, chunk_turns: flo
                            waiting=None):
     """Simulate ``cfg``; stop ``stop_after`` turns after the buckling crossing is detected.
 
-    The CW phase is run in chunks of ``chunk_turns``; after each chunk
-    :class:`~flagwrap.analysis.buckling.WaitingTime` (``waiting``, default criteria) is applied
-    to the free-end height so far. Once buckled with the crossing at least ``stop_after`` turns
-    back, the run stops (status "completed", message "stopped early ..."): the verdict and
-    ``t_c`` cannot change any more, and the post-buckling contact dynamics, the costly part of a
-    run, is skipped. ``stop_after=None`` runs the whole protocol. The final class of an early
-    stopped run is the state at the stop (a fold may still become a wrap later).
+    One uninterrupted run with a terminating event (:class:`BuckledStop`): from one turn into
+    the CW phase, every ``chunk_turns`` turns, :class:`~flagwrap.analysis.buckling.WaitingTime`
+    (``waiting``, default criteria) is applied to the free-end height so far. Once buckled with
+    the crossing at least ``stop_after`` turns back, the run stops (status "completed",
+    message "stopped early ..."): the verdict and ``t_c`` cannot change any more, and the
+    post-buckling contact dynamics, the costly part of a run, is skipped. ``stop_after=None``
+    runs the whole protocol. The final class of an early stopped run is the state at the stop
+    (a fold may still become a wrap later).
+
+    The state is never re-packed between pieces of the run (the event reads the trajectory
+    only), so this holds for every kind of system the config builds: lab or turning frame,
+    fixed or free body; the frames it keeps are those of the full run, bit for bit.
 
     Returns
     -------
     flagwrap.simulation.Trajectory
-        the chunks joined (core units).
     """
-    import time as _time
-
-    import numpy as np
     from threadpoolctl import threadpool_limits
 
-    from flagwrap.analysis.buckling import WaitingTime
-    from flagwrap.simulation import _RECORDS as keys
-    from flagwrap.simulation import TWO_PI, Simulation
+    from flagwrap.simulation import Simulation
 
-    waiting = waiting if waiting is not None else WaitingTime()
     with threadpool_limits(limits=cfg.numerics.threads):
         sim = Simulation(cfg)
-        sched = sim.system.schedule
         if stop_after is None:
             return sim.run()
-        cw = [seg for seg in sched.segments if seg.omega < 0]
-        t_cw0 = cw[0].t0 if cw else sched.t_end
-        edges = [min(t_cw0 + TWO_PI, sched.t_end)]
-        while edges[-1] < sched.t_end - 1e-9:
-            edges.append(min(edges[-1] + chunk_turns * TWO_PI, sched.t_end))
-        start = _time.perf_counter()
-        total, y0, base, t0 = None, None, None, 0.0
-        for t1 in edges:
-            # the run's budgets (numerics.max_steps / max_wall_time) hold for all chunks together
-            used = (total.n_steps if total is not None else 0, _time.perf_counter() - start)
-            part = sim.run(t_end=t1, y0=y0, base=base, t0=t0, budget_used=used)
-            if total is None:
-                total = part
-            else:
-                for k in keys:
-                    getattr(total, k).extend(getattr(part, k)[1:])
-                total.n_steps += part.n_steps
-                total.n_rejected += part.n_rejected
-                total.status, total.message, total.final_frames = part.status, part.message, part.final_frames
-            if part.status != "completed":
-                break
-            t0 = total.t[-1]
-            y0 = sim.system.pack(np.asarray(total.x[-1]), np.asarray(total.theta[-1]), total.phi[-1])
-            base = total.final_frames
-            if t1 >= sched.t_end - 1e-9 or t1 <= t_cw0:
-                continue
-            why = buckled_long_enough(total, waiting, stop_after)
-            if why:
-                total.message = why
-                break
-        total.wall_time = _time.perf_counter() - start
-    return total
+        stop = BuckledStop(sim.system.schedule, stop_after=stop_after, every_turns=chunk_turns,
+                           waiting=waiting)
+        return sim.run(stop=stop)
 
 
 def buckled_long_enough(traj, waiting, stop_after: float) -> str:
@@ -215,11 +191,8 @@ class BuckledStop:
     from one turn after the first CW phase starts (the schedule ``sched``), as
     :func:`simulate_until_buckled` checks at its chunk edges.
 
-    Unlike the chunked runs it does not restart the integrator, so the frames up to the stop
-    are those of the uninterrupted run, bit for bit. :func:`simulate_until_buckled` keeps the
-    chunks because the sweeps' and searches' cached results were made that way (their step
-    sizes restart at every chunk edge, which moves a run by up to the tolerance and can flip a
-    verdict next to M_c): switching them is a change of the result keys and a re-measurement.
+    It does not restart the integrator, so the frames up to the stop are those of the
+    uninterrupted run, bit for bit, and it works on every system (it never re-packs a state).
     """
 
     def __init__(self, sched, stop_after: float = 2.0, every_turns: float = 1.0, waiting=None):

@@ -248,8 +248,10 @@ class Case:
         from flagwrap import __version__
 
         cfg = self.config().replace(name="run")
+        from flagwrap.analysis.critical import RUNNER_REVISION
+
         payload = {"config": cfg.to_dict(for_hash=True), "stop_after": self.run.get("stop_after"),
-                   "version": __version__}
+                   "version": __version__, "runner_revision": RUNNER_REVISION}
         if self.runner is not None:  # a non-default case function makes other results
             payload["runner"] = self.runner
         return payload
