@@ -5,7 +5,9 @@ printing the step counts and a SHA-256 of the saved positions and motor torque.
     python benchmarks/trajectory_hash.py                     # this checkout
     PYTHONPATH=/path/to/other/src python benchmarks/trajectory_hash.py   # another commit
 
-Equal hashes mean bit-identical saved frames (same machine, same thread count).
+Equal hashes mean bit-identical saved frames (same machine, same thread count), with the
+sign of zero left out (``x + 0.0``): a bead at the origin may be -0.0 or +0.0 by the order of
+an exact addition, the same number.
 """
 
 import dataclasses
@@ -22,7 +24,7 @@ cfg = load_config(Path(__file__).resolve().parents[1] / "examples" / "fig4a.toml
 cfg = cfg.replace(motor=dataclasses.replace(cfg.motor, protocol=(Phase("ccw", 1.0), Phase("cw", 1.0))))
 traj = simulate(cfg)
 a = traj.arrays()
-digest = hashlib.sha256(np.ascontiguousarray(a["x"]).tobytes()
-                        + np.ascontiguousarray(a["motor_torque"]).tobytes()).hexdigest()[:16]
+digest = hashlib.sha256(np.ascontiguousarray(a["x"] + 0.0).tobytes()
+                        + np.ascontiguousarray(a["motor_torque"] + 0.0).tobytes()).hexdigest()[:16]
 print(f"fig4a 1+1 turns: {traj.n_steps} steps ({traj.n_rejected} rejected), frames {len(a['t'])}, "
       f"sha256 {digest}, free end {a['x'][-1, -1]}")

@@ -113,19 +113,19 @@ class Simulation:
         s = self.system
         info_in = info
         info = s.record_view(y, info)  # the lab frame (a turning-frame system rotates it back)
-        m1 = np.empty((s.N - 1, 3))
-        m2 = np.empty((s.N - 1, 3))
+        m1 = np.empty((len(info.theta), 3))
+        m2 = np.empty((len(info.theta), 3))
         from flagwrap.elasticity._kernels import material_frames
 
         material_frames(info.frames.t, info.frames.d1, info.theta, m1, m2)
         # everything computed before anything is appended: an interrupt in between must not
         # leave the records with different lengths
         phi = y[s.i_phi]
-        hook = s.joint.observables(info.x, info.theta, m1, m2, info.frames, s.rest)
+        hook = s.joint_observables(info, m1, m2)
         rate = s.motor_rate(y, info_in, omega)  # a torque motor's own rate
         row = (t, info.x.copy(), info.theta.copy(), m1, phi, rate,
                s.motor_torque(info_in, phi, omega), info.elastic_energy, info.contact_energy,
-               float(np.min(info.distance[s.nc:])) if s.N > s.nc else np.inf,
+               float(np.min(info.distance[s.free_beads])) if s.nb else np.inf,
                self._strain(info), info.interaction_energy) + hook
         body = getattr(s, "body_record", None)  # a moving body's pose and velocities
         body = None if body is None else body(y, info_in)
@@ -135,8 +135,8 @@ class Simulation:
             traj.body.append(body)
 
     def _strain(self, info) -> float:
-        ln = np.linalg.norm(np.diff(info.x, axis=0), axis=1)
-        return float(np.max(np.abs(ln / self.system.rest.l0 - 1.0)))
+        ln = self.system.bond_lengths(info.x)
+        return float(np.max(np.abs(ln / self.system.l0 - 1.0)))
 
     def _guard(self, info) -> str:
         s = self.system
@@ -144,19 +144,20 @@ class Simulation:
             k = int(np.flatnonzero(~np.isfinite(info.G))[0])
             block, i = s.layout.locate(k)
             if block == "x":
-                where = f"bead {s.nc + i // 3} (force component {'xyz'[i % 3]})"
+                where = f"bead {s.free_bead_ids[i // 3]} (force component {'xyz'[i % 3]})"
             elif block == "theta":
-                where = f"bond {s.ec + i} (twist torque)"
+                where = f"bond {s.free_bond_ids[i]} (twist torque)"
             else:
                 where = f"unknown {k} ({block})"
             return f"non-finite generalized force {info.G[k]} on {where}"
-        if s.N > s.nc and np.min(info.distance[s.nc:]) <= 0.0:
-            i = int(np.argmin(info.distance[s.nc:])) + s.nc
+        if s.nb and np.min(info.distance[s.free_beads]) <= 0.0:
+            i = int(s.free_bead_ids[np.argmin(info.distance[s.free_beads])])
             return f"bead {i} entered the cell body (distance {info.distance[i]:.3g} L)"
-        strain = np.abs(np.linalg.norm(np.diff(info.x, axis=0), axis=1) / s.rest.l0 - 1.0)
+        strain = np.abs(s.bond_lengths(info.x) / s.l0 - 1.0)
         if strain.max() > self.max_strain_limit:
             j = int(np.argmax(strain))
-            return (f"bond {j} (beads {j}-{j + 1}) strain {strain[j]:.3g} exceeds the limit "
+            i = int(s.bond_first[j])
+            return (f"bond {j} (beads {i}-{i + 1}) strain {strain[j]:.3g} exceeds the limit "
                     f"{self.max_strain_limit:g} (stretching springs no longer inextensible)")
         return ""
 
@@ -167,7 +168,7 @@ class Simulation:
             v = s.apply_mobility(y, info.G)[s.sl_x].reshape(-1, 3)
             sp = np.linalg.norm(v, axis=1)
             i = int(np.nanargmax(sp))
-            return f"; fastest bead {s.nc + i} (|dx/dt| = {sp[i]:.3g} L omega)"
+            return f"; fastest bead {s.free_bead_ids[i]} (|dx/dt| = {sp[i]:.3g} L omega)"
         except (ValueError, FloatingPointError):
             return ""
 
@@ -176,15 +177,16 @@ class Simulation:
         start inside the body's contact range (a fine chain: the repulsion throws them off)."""
         s = self.system
         cutoff = getattr(s.body, "cutoff", None)
-        if cutoff is None or s.N <= s.nc:
+        if cutoff is None or not s.nb:
             return ""
-        # the beads next to the clamp: as far along the chain as the contact range reaches
-        near = s.nc + int(np.ceil(cutoff / s.bond)) + 1
-        d = info.distance[s.nc:near]
+        # the beads next to each clamp: as far along the chain as the contact range reaches
+        near = np.concatenate([np.arange(p.bead0 + p.nc, min(p.bead0 + p.N, p.bead0 + p.nc + int(
+            np.ceil(cutoff / s.bond)) + 1)) for p in s.parts])
+        d = info.distance[near]
         inside = np.flatnonzero(d < cutoff)
         if not inside.size:
             return ""
-        i = int(inside[np.argmin(d[inside])]) + s.nc
+        i = int(near[inside[np.argmin(d[inside])]])
         L = self.config.filament.length
         return (f"; bead {i} starts {info.distance[i] * L * 1e3:.3g} mm from the cell body, inside "
                 f"its contact range a (1 + contact.range) = {cutoff * L * 1e3:.3g} mm: with "

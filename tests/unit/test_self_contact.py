@@ -110,5 +110,6 @@ def test_kernel_skips_contour_neighbours():
     sc = SelfContact(radius=0.01, bond=0.02, range=1.0)
     assert sc.exclude == 3
     g = np.zeros_like(x)
-    E, dmin = self_contact_energy_grad(x, sc.cut, sc.sigma, sc.eps, sc.c2, sc.first(len(x) - 1), g)
+    E, dmin = self_contact_energy_grad(x, sc.cut, sc.sigma, sc.eps, sc.c2, sc.first(len(x) - 1), g,
+                                     sc.skip(len(x) - 1))
     assert E == 0.0 and not g.any() and dmin >= 0.02 * (sc.exclude) - 1e-12

@@ -254,7 +254,7 @@ def _band_structure(system, rows, cols, width):
     import scipy.sparse as sp
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-    n = system.ny - 1
+    n = system.ny - system.layout.block("phi").size
     n3 = 3 * system.nb
     keep = (rows < n) & (cols < n)
     J = sp.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(n, n))
@@ -282,9 +282,10 @@ class BandedW:
     (then this LU is exact: the default solver for the paper's "without HIs" runs); with HI
     on it is the preconditioner of :class:`KrylovW` and the ``W`` of :class:`NearW`.
 
-    The motor angle ``phi`` is the last unknown; no force depends on it through ``J``'s rows
-    (``dphi/dt = omega`` is prescribed), so ``W``'s last row is ``e_phi`` and its last column
-    ``w`` only feeds the others: ``u_phi = r_phi``, ``W' u' = r' - w u_phi``. ``W'`` (beads and
+    The motor angles ``phi`` (one per filament) are the last unknowns; no force depends on
+    them through ``J``'s rows (``dphi/dt = omega`` is prescribed), so ``W``'s last rows are
+    the identity and its last columns ``w`` only feed the others: ``u_phi = r_phi``,
+    ``W' u' = r' - w u_phi``. ``W'`` (beads and
     twists) is reordered by reverse Cuthill-McKee, which interleaves beads and twists along
     the chain and makes it banded (half-bandwidths ~10 for ``width = 0``, ~5 more per unit
     of width): factorising costs O(N kl (kl + ku)) without sparse-LU bookkeeping.
@@ -299,10 +300,10 @@ class BandedW:
         # pairs farther apart than the chain is long do not exist: clamp (short chains)
         width = min(int(width), max(system.nb - 1, 0)) if system.mobility.long_range else 0
         perm, inv, kl, ku = _band_structure(system, rows, cols, width)
-        n = system.ny - 1
+        n = system.ny - system.layout.block("phi").size
         Mb, mt = system.near_field_blocks(y, width)
         ab = np.empty((2 * kl + ku + 1, n), order="F")
-        self.w = np.empty(n)
+        self.w = np.empty((n, system.ny - n))
         band_from_triplets(rows, cols, vals, Mb, width, mt, gamma_h, inv, kl, ku, n, ab, self.w)
         lu, piv, info = dgbtrf(ab, kl, ku, overwrite_ab=1)
         if info != 0 or not np.all(np.isfinite(lu)):
@@ -313,13 +314,17 @@ class BandedW:
         from scipy.linalg.lapack import dgbtrs
 
         n = self.n
-        u_phi = rhs[n]
-        x, info = dgbtrs(self.lu, self.kl, self.ku, (rhs[:n] - self.w * u_phi)[self.perm], self.piv)
+        u_phi = rhs[n:]
+        if len(u_phi) == 1:  # one motor: a column times a number
+            r = rhs[:n] - self.w[:, 0] * u_phi[0]
+        else:
+            r = rhs[:n] - self.w @ u_phi
+        x, info = dgbtrs(self.lu, self.kl, self.ku, r[self.perm], self.piv)
         if info != 0:
             raise SingularW(f"banded solve failed (info {info})")
-        out = np.empty(n + 1)
+        out = np.empty(len(rhs))
         out[self.perm] = x
-        out[n] = u_phi
+        out[n:] = u_phi
         return out
 
 

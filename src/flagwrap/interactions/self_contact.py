@@ -84,10 +84,12 @@ def _pair_law(d, cut, sigma, eps, k2):
 
 
 @nb.njit(cache=True)
-def self_contact_energy_grad(x, cut, sigma, eps, c2, first, grad):
+def self_contact_energy_grad(x, cut, sigma, eps, c2, first, grad, skip):
     """Energy of the segment-pair repulsion of the chain ``x`` (N, 3); adds ``dU/dx`` to
     ``grad``. Segment ``i`` meets segments ``j >= first[i]`` only (its contour neighbours are
-    skipped). Returns ``(energy, smallest segment distance among the pairs considered)``."""
+    skipped), and none with ``skip[j]`` (the joins between the chains of several filaments
+    laid end to end, which are no segments). Returns ``(energy, smallest segment distance
+    among the pairs considered)``."""
     n = x.shape[0] - 1
     k2 = c2 * 72.0 * eps / (cut * cut)
     E = 0.0
@@ -100,6 +102,8 @@ def self_contact_energy_grad(x, cut, sigma, eps, c2, first, grad):
         hi = 0.5 * math.sqrt((x[i + 1, 0] - x[i, 0]) ** 2 + (x[i + 1, 1] - x[i, 1]) ** 2
                              + (x[i + 1, 2] - x[i, 2]) ** 2)
         for j in range(first[i], n):
+            if skip[j]:
+                continue
             cjx = 0.5 * (x[j, 0] + x[j + 1, 0])
             cjy = 0.5 * (x[j, 1] + x[j + 1, 1])
             cjz = 0.5 * (x[j, 2] + x[j + 1, 2])
@@ -133,7 +137,8 @@ def self_contact_energy_grad(x, cut, sigma, eps, c2, first, grad):
 
 
 class SelfContact:
-    """Repulsion between non-neighbouring segments of one filament (core units).
+    """Repulsion between non-neighbouring segments of one filament, or of several laid end to
+    end (``chains``), which then also repel each other (core units).
 
     Parameters
     ----------
@@ -148,10 +153,16 @@ class SelfContact:
         energy scale ``eps`` [A/L] (the body contact uses ``contact.strength / b``).
     c2 : float
         1: "wca-c2" (continuous force derivative at the cut-off, the default); 0: plain WCA.
+    chains : sequence of int, optional
+        the bead counts of several filaments whose beads ``x`` holds one after the other
+        (``rest_lengths`` then holds their bonds only, one chain after the other): each
+        keeps its own contour exclusion, every pair of segments on different chains is a
+        contact pair, and the join from one chain's last bead to the next one's first is no
+        segment.
     """
 
     def __init__(self, radius: float, bond: float, range: float = 1.0, strength: float = 1.0,
-                 c2: float = 1.0, rest_lengths=None):
+                 c2: float = 1.0, rest_lengths=None, chains=None):
         if not (radius > 0 and bond > 0 and range > 0 and strength > 0):
             raise ValueError("SelfContact: radius, bond, range and strength must be > 0")
         self.cut = radius * (2.0 + range)
@@ -162,11 +173,19 @@ class SelfContact:
         # bonds whose contour distance is within the cut-off are neighbours, not contacts
         self.exclude = int(math.ceil(self.cut / bond)) + 1
         self._first_n = None
+        self.chains = None if chains is None else [int(n) for n in chains]
+        if self.chains is not None and (min(self.chains) < 2 or (
+                self.rest_lengths is not None
+                and len(self.rest_lengths) != sum(self.chains) - len(self.chains))):
+            raise ValueError("SelfContact: chains need >= 2 beads each and rest_lengths one "
+                             "entry per bond of every chain")
 
     def first(self, n_segments: int) -> np.ndarray:
         """``first[i]``: the first segment that segment ``i`` can touch (module docstring)."""
         if self._first_n is not None and self._first_n[0] == n_segments:
             return self._first_n[1]
+        if self.chains is not None:
+            return self._chains_first(n_segments)
         if self.rest_lengths is None:
             first = np.arange(n_segments, dtype=np.int64) + self.exclude + 1
         else:
@@ -176,7 +195,32 @@ class SelfContact:
             # first j with arc[j] - arc[i + 1] >= need
             first = np.searchsorted(arc, arc[1:] + need, side="left").astype(np.int64)
         first = np.minimum(first, n_segments)
-        self._first_n = (n_segments, first)
+        self._first_n = (n_segments, first, np.zeros(n_segments, np.bool_))
+        return first
+
+    def skip(self, n_segments: int) -> np.ndarray:
+        """``skip[j]``: segment ``j`` is the join between two chains (``chains``)."""
+        self.first(n_segments)
+        return self._first_n[2]
+
+    def _chains_first(self, n_segments: int) -> np.ndarray:
+        if n_segments != sum(self.chains) - 1:
+            raise ValueError(f"SelfContact: {n_segments + 1} beads, chains of {self.chains}")
+        first = np.empty(n_segments, np.int64)
+        skip = np.zeros(n_segments, np.bool_)
+        start = bond = 0  # first bead of the chain, its first bond among rest_lengths
+        for n in self.chains:
+            one = SelfContact.__new__(SelfContact)  # this chain alone, same law
+            one.__dict__.update(self.__dict__)
+            one.chains, one._first_n = None, None
+            if self.rest_lengths is not None:
+                one.rest_lengths = self.rest_lengths[bond:bond + n - 1]
+            first[start:start + n - 1] = start + one.first(n - 1)
+            if start + n - 1 < n_segments:  # the join to the next chain
+                first[start + n - 1] = n_segments
+                skip[start + n - 1] = True
+            start, bond = start + n, bond + n - 1
+        self._first_n = (n_segments, first, skip)
         return first
 
     @property
@@ -191,14 +235,16 @@ class SelfContact:
     def energy_grad(self, x: np.ndarray, grad: np.ndarray) -> tuple[float, float]:
         """``(energy, smallest distance)``; adds ``dU/dx`` to ``grad`` (N, 3)."""
         x = np.ascontiguousarray(x, float)
+        n = len(x) - 1
         return self_contact_energy_grad(x, self.cut, self.sigma, self.eps, self.c2,
-                                        self.first(len(x) - 1), grad)
+                                        self.first(n), grad, self.skip(n))
 
     def hessian_coo(self, x: np.ndarray):
         """``d^2 U / dx^2`` as COO triplets over bead coordinates ``3 i + c`` (active pairs only)."""
         x = np.ascontiguousarray(x, float)
+        n = len(x) - 1
         return self_contact_hessian(x, self.cut, self.sigma, self.eps, self.c2,
-                                    self.first(len(x) - 1))
+                                    self.first(n), self.skip(n))
 
 
 @nb.njit(cache=True)
@@ -218,7 +264,7 @@ def _pair_grad(P, cut, sigma, eps, k2, out):
 
 
 @nb.njit(cache=True)
-def self_contact_hessian(x, cut, sigma, eps, c2, first):
+def self_contact_hessian(x, cut, sigma, eps, c2, first, skip):
     """Hessian triplets of the pairs within the cut-off: central differences (step
     ``1e-6 d_c``) of the exact pair gradient, 144 entries per active pair."""
     n = x.shape[0] - 1
@@ -227,6 +273,8 @@ def self_contact_hessian(x, cut, sigma, eps, c2, first):
     pairs_j = []
     for i in range(n):
         for j in range(first[i], n):
+            if skip[j]:
+                continue
             s, t, dx, dy, dz = segment_closest(x[i], x[i + 1], x[j], x[j + 1])
             if dx * dx + dy * dy + dz * dz < cut * cut:
                 pairs_i.append(i)

@@ -18,7 +18,8 @@ from flagwrap.joints.base import Joint
 
 
 class AxialClamp(Joint):
-    """Clamped first bond, rotated about ``axis`` (unit, through the origin) by ``phi``.
+    """Clamped first bond, rotated about ``axis`` (unit) through ``origin`` (the anchor, the
+    system's origin by default) by ``phi``.
 
     Attributes
     ----------
@@ -29,9 +30,12 @@ class AxialClamp(Joint):
     n_beads = 2
     n_edges = 1
 
-    def __init__(self, x0: np.ndarray, theta0: np.ndarray, axis=(0.0, 0.0, -1.0)):
+    def __init__(self, x0: np.ndarray, theta0: np.ndarray, axis=(0.0, 0.0, -1.0),
+                 origin=(0.0, 0.0, 0.0)):
         self.axis = np.asarray(axis, float) / np.linalg.norm(axis)
-        self.x_ref = np.array(x0[: self.n_beads], float)
+        self.origin = np.array(origin, float)
+        # the held beads relative to the anchor (what the fused kernel rotates)
+        self.x_ref = np.array(x0[: self.n_beads], float) - self.origin
         self.theta_ref = np.array(theta0[: self.n_edges], float)
         # generators: d x_c / d phi = axis x x_c, d theta_0 / d phi = 1 (if the bond is on axis,
         # its material frame turns about its own tangent at exactly the motor rate)
@@ -46,13 +50,13 @@ class AxialClamp(Joint):
         self._cross = np.cross(self.axis, self._perp)
 
     def positions(self, phi: float) -> np.ndarray:
-        return self._par + math.cos(phi) * self._perp + math.sin(phi) * self._cross
+        return self.origin + (self._par + math.cos(phi) * self._perp + math.sin(phi) * self._cross)
 
     def theta(self, phi: float) -> np.ndarray:
         return self.theta_ref + self.twist_rate * phi
 
     def generalized_force(self, phi: float, grad_x: np.ndarray, grad_th: np.ndarray) -> float:
         """``dE/dphi`` from the energy gradient on the clamped beads and twist angles."""
-        xc = self.positions(phi)
+        xc = self.positions(phi) - self.origin
         dx = np.cross(self.axis, xc)
         return float(np.sum(dx * grad_x[: self.n_beads]) + self.twist_rate * grad_th[0])

@@ -41,8 +41,9 @@ class LumpedHook(AxialClamp):
 
     kind = "hook"
 
-    def __init__(self, x0, theta0, k_bend: float, k_twist: float, axis=(0.0, 0.0, -1.0)):
-        super().__init__(x0, theta0, axis)
+    def __init__(self, x0, theta0, k_bend: float, k_twist: float, axis=(0.0, 0.0, -1.0),
+                 origin=(0.0, 0.0, 0.0)):
+        super().__init__(x0, theta0, axis, origin)
         if not (k_bend > 0 and k_twist > 0):
             raise ValueError("LumpedHook: k_bend and k_twist must be > 0")
         self.k_bend = float(k_bend)
@@ -84,8 +85,8 @@ class ResolvedHook(AxialClamp):
     kind = "hook"
 
     def __init__(self, x0, theta0, length, segments, bending, twist, rod_bending, rod_twist,
-                 bond, axis=(0.0, 0.0, -1.0)):
-        super().__init__(x0, theta0, axis)
+                 bond, axis=(0.0, 0.0, -1.0), origin=(0.0, 0.0, 0.0)):
+        super().__init__(x0, theta0, axis, origin)
         if not (length > 0 and segments >= 2 and bending > 0 and twist > 0):
             raise ValueError("ResolvedHook: length, bending, twist > 0 and segments >= 2 needed")
         self.length, self.segments = float(length), int(segments)

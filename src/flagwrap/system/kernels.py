@@ -18,7 +18,9 @@ from flagwrap.elasticity._kernels import energy_grad
 
 
 @nb.njit(cache=True)
-def unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta):
+def unpack(y, nc, ec, x_ref, axis, origin, theta_ref, twist_rate, x, theta):
+    """The joint's beads rotated by the motor angle ``phi = y[-1]`` about ``axis`` through
+    ``origin`` (``x_ref`` relative to ``origin``), then the free beads and bonds from ``y``."""
     N = x.shape[0]
     phi = y[y.shape[0] - 1]
     c = math.cos(phi)
@@ -29,9 +31,9 @@ def unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta):
         ky = axis[2] * v0 - axis[0] * v2
         kz = axis[0] * v1 - axis[1] * v0
         kv = axis[0] * v0 + axis[1] * v1 + axis[2] * v2
-        x[i, 0] = c * v0 + s * kx + (1 - c) * kv * axis[0]
-        x[i, 1] = c * v1 + s * ky + (1 - c) * kv * axis[1]
-        x[i, 2] = c * v2 + s * kz + (1 - c) * kv * axis[2]
+        x[i, 0] = origin[0] + (c * v0 + s * kx + (1 - c) * kv * axis[0])
+        x[i, 1] = origin[1] + (c * v1 + s * ky + (1 - c) * kv * axis[1])
+        x[i, 2] = origin[2] + (c * v2 + s * kz + (1 - c) * kv * axis[2])
     k = 0
     for i in range(nc, N):
         x[i, 0] = y[k]
@@ -46,13 +48,13 @@ def unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta):
 
 
 @nb.njit(cache=True)
-def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
+def generalized_forces(y, nc, ec, x_ref, axis, origin, theta_ref, twist_rate,
                        base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
                        has_body, Rc, H, sigma, eps, c2, gravity,
                        G, x, theta, gx, gth, d1_out, rt_out, dist, shape=0):
     """Fill ``G`` (ny,) and the work arrays; return (elastic energy, contact energy)."""
     N = x.shape[0]
-    unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta)
+    unpack(y, nc, ec, x_ref, axis, origin, theta_ref, twist_rate, x, theta)
     E = energy_grad(x, theta, base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
                     gx, gth, d1_out, rt_out)
     Ec = 0.0
@@ -78,7 +80,7 @@ def generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate,
 
 @nb.njit(cache=True)
 def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
-                    nc, ec, x_ref, axis, theta_ref, twist_rate,
+                    nc, ec, x_ref, axis, origin, theta_ref, twist_rate,
                     base_t, base_d1, base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks,
                     has_body, Rc, H, sigma, eps, c2, gravity, shape=0):
     """``J = dG/dy`` as COO triplets (duplicates to be summed), O(N) time and memory.
@@ -107,14 +109,14 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
     rows = np.empty(n_tot, np.int64)
     cols = np.empty(n_tot, np.int64)
     vals = np.empty(n_tot)
-    generalized_forces(y, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
+    generalized_forces(y, nc, ec, x_ref, axis, origin, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, 0.0, has_body, Rc, H, sigma,
                        eps, c2, gravity, Gs, x, theta, gx, gth, d1, rt, dist, shape)
     n_groups = g_ptr.shape[0] - 1
     for g in range(n_groups):
         for q in range(g_ptr[g], g_ptr[g + 1]):
             yp[g_cols[q]] += delta
-        generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
+        generalized_forces(yp, nc, ec, x_ref, axis, origin, theta_ref, twist_rate, base_t, base_d1,
                            base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, 0.0, has_body, Rc, H, sigma,
                            eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist, shape)
         for q in range(e_ptr[g], e_ptr[g + 1]):
@@ -126,7 +128,7 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
             yp[g_cols[q]] = y[g_cols[q]]
     k = n_e
     # exact stretching Hessian on the free beads (J = -Hessian)
-    unpack(y, nc, ec, x_ref, axis, theta_ref, twist_rate, x, theta)
+    unpack(y, nc, ec, x_ref, axis, origin, theta_ref, twist_rate, x, theta)
     for j in range(N - 1):
         e0 = x[j + 1, 0] - x[j, 0]
         e1 = x[j + 1, 1] - x[j, 1]
@@ -151,7 +153,7 @@ def fd_jacobian_coo(y, G0, delta, g_ptr, g_cols, e_ptr, e_rows, e_cols, N,
                         vals[k] = -sgn * K
                         k += 1
     yp[ny - 1] += delta
-    generalized_forces(yp, nc, ec, x_ref, axis, theta_ref, twist_rate, base_t, base_d1,
+    generalized_forces(yp, nc, ec, x_ref, axis, origin, theta_ref, twist_rate, base_t, base_d1,
                        base_rt, l0, cbend, ctwist, angle_law, kbar, mbar, ks, has_body, Rc, H, sigma,
                        eps, c2, gravity, G, x, theta, gx, gth, d1, rt, dist, shape)
     for r in range(ny):
@@ -180,7 +182,7 @@ def unit_tangents(x, t):
 @nb.njit(cache=True)
 def band_from_triplets(rows, cols, vals, Mb, wd, mt, gamma_h, inv, kl, ku, n, ab, w):
     """LAPACK band storage of ``W' = I - gamma h Mob_near J`` (beads and twists, in the
-    reverse-Cuthill-McKee order ``inv``) and the motor-angle column ``w`` (see
+    reverse-Cuthill-McKee order ``inv``) and the motor-angle columns ``w`` (n, n_motors) (see
     :class:`~flagwrap.integrators.linear.BandedW`).
 
     ``Mob_near``: translational 3x3 blocks ``Mb[i, wd + k] = Mob_{i, i+k}`` for |k| <= wd
@@ -211,16 +213,16 @@ def band_from_triplets(rows, cols, vals, Mb, wd, mt, gamma_h, inv, kl, ku, n, ab
                 for m in range(3):
                     i = 3 * ib + m
                     val = Mb[ib, wd - dp, m, k] * v
-                    if c == n:
-                        w[i] += val
+                    if c >= n:
+                        w[i, c - n] += val
                     else:
                         off = kl + ku + inv[i] - inv[c]
                         if kl <= off <= top:  # a term outside the band is left out of W
                             ab[off, inv[c]] += val
         else:
             val = mt[r - nb3] * v
-            if c == n:
-                w[r] += val
+            if c >= n:
+                w[r, c - n] += val
             else:
                 off = kl + ku + inv[r] - inv[c]
                 if kl <= off <= top:

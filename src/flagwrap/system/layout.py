@@ -10,8 +10,8 @@ layout instead of assuming "positions first, then twists, the motor angle last".
   bond's surface by 10 tol a, ~0.04 tol L at the paper's a/L: docs/numerics.md);
 * ``"prescribed"``: driven coordinates (the motor angle), no error (weight ``inf``).
 
-Today one filament with a clamp: ``[x_free (3 n_b), theta_free (n_e), phi]``
-(:meth:`DofLayout.clamped_filament`). Joints, bodies and more filaments add blocks.
+Filaments with clamps: ``[x_free (3 n_b), theta_free (n_e), phi (one per motor)]``
+(:meth:`DofLayout.clamped_filament`); a free body adds its pose.
 """
 
 from __future__ import annotations
@@ -60,11 +60,12 @@ class DofLayout:
 
     @classmethod
     def clamped_filament(cls, n_free_beads: int, n_free_bonds: int,
-                         motor: str = "prescribed") -> "DofLayout":
-        """One filament behind a motor clamp: free bead positions, free twist angles, motor
-        angle (``motor = "angle"``: a torque-driven motor's angle, an unknown like the rest)."""
+                         motor: str = "prescribed", n_motors: int = 1) -> "DofLayout":
+        """Filaments behind motor clamps: free bead positions, free twist angles, motor
+        angles (``motor = "angle"``: a torque-driven motor's angle, an unknown like the rest),
+        one per filament (:mod:`flagwrap.system.parts`)."""
         return cls([("x", "position", 3 * n_free_beads), ("theta", "angle", n_free_bonds),
-                    ("phi", motor, 1)])
+                    ("phi", motor, n_motors)])
 
     def __getitem__(self, name: str) -> slice:
         return self._by_name[name].slice

@@ -28,13 +28,14 @@ import numpy as np
 
 from flagwrap.system import kernels as SK
 from flagwrap.body.cell_body import CappedCylinder, NoBody, body_mobility
-from flagwrap.elasticity.rod import Frames, RestState, initial_frames, rest_state
+from flagwrap.elasticity.rod import Frames
 from flagwrap.geometry.helix import filament_positions
 from flagwrap.hydrodynamics.mobility import make_mobility
 from flagwrap.joints import make_joint
 from flagwrap.motor.drive import make_drive
 from flagwrap.motor.protocol import Schedule
 from flagwrap.system.layout import DofLayout
+from flagwrap.system.parts import FilamentPart, Placement
 
 
 @dataclass
@@ -53,66 +54,85 @@ class ForceInfo:
     interaction_energy: float = 0.0
 
 
+class SeveralFilaments(TypeError):
+    """A single-filament attribute (``joint``, ``rest``, ``nc`` ...) asked of a system of
+    several filaments: ask ``system.parts[k]`` instead."""
+
+
+def _one_filament(name: str):
+    """A property that is the only filament's ``name`` (settable, e.g. by tests that swap
+    a joint) and refuses by name on a system of several."""
+
+    def get(self):
+        if len(self.parts) != 1:
+            raise SeveralFilaments(
+                f"RodSystem.{name}: this system has {len(self.parts)} filaments; read "
+                f"system.parts[k].{name} for filament k")
+        return getattr(self.parts[0], name)
+
+    def put(self, value):
+        if len(self.parts) != 1:
+            raise SeveralFilaments(f"RodSystem.{name}: set it on system.parts[k]")
+        setattr(self.parts[0], name, value)
+
+    return property(get, put)
+
+
 class RodSystem:
-    """Forces, mobility and bookkeeping of one run (core units)."""
+    """Forces, mobility and bookkeeping of one run (core units): one or several filaments
+    (:class:`~flagwrap.system.parts.FilamentPart`), each on its motor, a body and one mobility
+    over all their free beads."""
+
+    joint = clamp = _one_filament("joint")
+    rest = _one_filament("rest")
+    nc = _one_filament("nc")
+    ec = _one_filament("ec")
 
     def __init__(self, config, x0=None, theta0=None, body=None, clamp=None, mobility=None,
-                 joint=None, interactions=()):
+                 joint=None, interactions=(), placements=None):
         """``joint`` (or its old name ``clamp``): a built joint for the shape ``x0`` (default:
         :func:`flagwrap.joints.make_joint` from ``config.joint``); ``interactions``: extra
-        energy terms (:mod:`flagwrap.interactions.base`) after those the config asks for."""
+        energy terms (:mod:`flagwrap.interactions.base`) after those the config asks for;
+        ``placements``: one :class:`~flagwrap.system.parts.Placement` per filament (default:
+        one filament at the origin), each a copy of the config's filament and joint on its
+        own speed motor (the motors turn together, by ``config.motor``'s protocol)."""
         self.config = config
         fil = config.filament
         L = fil.length
         self.scales = config.scales
         self.machin = config.machin
-        x0 = filament_positions(fil, config.clamp) / L if x0 is None else np.asarray(x0, float)
-        theta0 = np.zeros(len(x0) - 1) if theta0 is None else np.asarray(theta0, float)
-        joint = joint or clamp
-        if joint is None:  # the joint may add beads (a resolved hook): it returns the shape
-            joint, x0, theta0 = make_joint(config, x0, theta0)
-        N = len(x0)
-        self.N = N
-        frames = initial_frames(x0)
+        placements = [Placement()] if placements is None else list(placements)
+        if not placements:
+            raise ValueError("RodSystem: placements must hold at least one filament")
+        if len(placements) > 1 and (x0 is not None or (joint or clamp) is not None):
+            raise ValueError("RodSystem: a given x0 or joint is for one filament, not several")
         b = fil.bond_length / L
         self.bond = b
         # Step of the coloured finite-difference Jacobian, a fixed fraction of the bond: bending
         # and twist forces depend on displacements through angles ~ dx / b, so this keeps the
         # relative accuracy of J the same at every N (measured: docs/numerics.md, "Cost").
         self.fd_step = 6e-6 * b
-        self.joint = self.clamp = joint
-        self.rest: RestState = joint.rest(rest_state(
-            x0, frames, theta0,
-            bending=1.0,
-            twist=fil.twist_modulus / fil.bending_modulus,
-            stretch=fil.stretch_stiffness / b**3,
-        ))
-        self.frames0 = frames
-        self.x0 = x0
-        self.theta0 = theta0
-        nc, ec = joint.n_beads, joint.n_edges
-        self.nc, self.ec = nc, ec
-        self.nb = N - nc  # free beads
-        self.ne = N - 1 - ec  # free bonds
-        self.layout = DofLayout.clamped_filament(
-            self.nb, self.ne, "prescribed" if config.motor.kind == "speed" else "angle")
-        self.ny = self.layout.size
-        self.sl_x = self.layout["x"]
-        self.sl_th = self.layout["theta"]
-        self.i_phi = self.layout.block("phi").start  # the motor angle's index in y
-        # the fused kernels and the dense/banded W assemblies take y in this block order
-        assert [b.name for b in self.layout.blocks] == ["x", "theta", "phi"], self.layout
-        # hydrodynamics (radius in core units)
-        self.radius = fil.bead_radius / L
+        self.radius = fil.bead_radius / L  # hydrodynamics (radius in core units)
+        parts = []
+        for k, place in enumerate(placements):
+            xk = filament_positions(fil, config.clamp) / L if x0 is None else np.asarray(x0, float)
+            thk = np.zeros(len(xk) - 1) if theta0 is None else np.asarray(theta0, float)
+            xk = place.apply(xk)
+            jk = joint or clamp
+            if jk is None:  # the joint may add beads (a resolved hook): it returns the shape
+                jk, xk, thk = make_joint(config, xk, thk, axis=tuple(place.axis),
+                                         origin=place.origin)
+            parts.append(FilamentPart(
+                xk, thk, jk, bond=b, twist=fil.twist_modulus / fil.bending_modulus,
+                stretch=fil.stretch_stiffness / b**3, radius=self.radius,
+                gravity_number=config.gravity_number if fil.density is not None else None,
+                name=f"flagellum{k}"))
+        self.parts = parts
+        self._assemble(config)
         num = config.numerics
         self.mobility = mobility or body_mobility(config, self.radius) or make_mobility(
             num.hydrodynamics, self.radius, backend=num.mobility_backend,
-            n=N, threads=num.threads, fmm_eps=num.mobility_tol)
-        w = np.ones(N - 1)
-        w[0] += 0.5
-        w[-1] += 0.5
-        self.rot_drag = 8.0 * math.pi * self.radius**3 * w  # geometric, times M gives core drag
-        self.twist_mobility = 1.0 / (self.machin * self.rot_drag[self.ec:])  # free bonds, core
+            n=self.N, threads=num.threads, fmm_eps=num.mobility_tol)
         # cell body
         if config.body.enabled:
             R = fil.helix_radius
@@ -121,26 +141,74 @@ class RodSystem:
                 length=config.body.resolved_length(R) / L,
                 cutoff=fil.cross_section_radius * (1.0 + config.contact.range) / L,
                 strength=config.contact.strength / b,
-                first_bead=nc,
+                first_bead=parts[0].nc,
                 potential=config.contact.potential,
                 shape=config.body.shape,
             )
         else:
             self.body = body or NoBody()
-        # gravity/buoyancy: force per bead (core units) along +z, G l / L for a bead carrying
-        # contour l (half a bond at the ends): units.gravity_number
-        self.gravity = np.zeros((N, 3))
-        if fil.density is not None:
-            # half of each adjacent bond's nominal length (b, or a hook's short bonds)
-            lb = np.where(np.abs(self.rest.l0 - b) < 1e-9 * b, b, self.rest.l0)
-            per_bead = np.empty(N)
-            per_bead[0], per_bead[-1] = 0.5 * lb[0], 0.5 * lb[-1]
-            per_bead[1:-1] = 0.5 * (lb[:-1] + lb[1:])
-            self.gravity[:, 2] = config.gravity_number * per_bead
+        self._has_body = not isinstance(self.body, NoBody)
         self.schedule = Schedule(config.motor.protocol)
         self.drive = make_drive(config, zeta=self.machin * self.rot_drag[0])
-        self._colors = None
+        if len(parts) > 1 and self.drive.free:
+            from flagwrap.errors import UserInputError
+
+            raise UserInputError(
+                f"motor.kind = {config.motor.kind!r}: several flagella run on speed motors "
+                "only for now (motor.kind = \"speed\")")
         self.interactions = self._config_interactions() + list(interactions)
+
+    def _assemble(self, config) -> None:
+        """Offsets of every part's beads, bonds and unknowns; the system's layout and its
+        concatenated rest shape, frames, drags and gravity (module docstring of
+        :mod:`flagwrap.system.parts`)."""
+        parts = self.parts
+        single = len(parts) == 1
+        self.n_filaments = len(parts)
+        self.N = sum(p.N for p in parts)
+        self.nb = sum(p.nb for p in parts)  # free beads
+        self.ne = sum(p.ne for p in parts)  # free bonds
+        motor = "prescribed" if config.motor.kind == "speed" else "angle"
+        self.layout = DofLayout.clamped_filament(self.nb, self.ne, motor, n_motors=len(parts))
+        self.ny = self.layout.size
+        self.sl_x = self.layout["x"]
+        self.sl_th = self.layout["theta"]
+        self.sl_phi = self.layout["phi"]
+        self.i_phi = self.sl_phi.start  # the (first) motor angle's index in y
+        # the fused kernels and the dense/banded W assemblies take y in this block order
+        assert [b.name for b in self.layout.blocks] == ["x", "theta", "phi"], self.layout
+        bead0 = bond0 = fb0 = fe0 = 0
+        for k, p in enumerate(parts):
+            p.assign_offsets(bead0, bond0, fb0, fe0, self.sl_th.start, self.i_phi + k, single)
+            bead0, bond0, fb0, fe0 = bead0 + p.N, bond0 + p.N - 1, fb0 + p.nb, fe0 + p.ne
+        cat = np.concatenate
+        if single:
+            p = parts[0]
+            self.free_beads, self.free_bonds = slice(p.nc, None), slice(p.ec, None)
+            self.x0, self.theta0, self.frames0 = p.x0, p.theta0, p.frames0
+            self.rot_drag, self.gravity, self.l0 = p.rot_drag, p.gravity, p.rest.l0
+        else:
+            self.free_beads = cat([np.arange(p.bead0 + p.nc, p.bead0 + p.N) for p in parts])
+            self.free_bonds = cat([np.arange(p.bond0 + p.ec, p.bond0 + p.N - 1) for p in parts])
+            self.x0 = cat([p.x0 for p in parts])
+            self.theta0 = cat([p.theta0 for p in parts])
+            self.frames0 = Frames(cat([p.frames0.t for p in parts]),
+                                  cat([p.frames0.d1 for p in parts]),
+                                  cat([p.frames0.rt for p in parts]))
+            self.rot_drag = cat([p.rot_drag for p in parts])
+            self.gravity = cat([p.gravity for p in parts])
+            self.l0 = cat([p.rest.l0 for p in parts])
+        #: the system's bead and bond numbers of the free unknowns, in y's order
+        self.free_bead_ids = np.arange(self.N)[self.free_beads]
+        self.free_bond_ids = np.arange(self.N - len(parts))[self.free_bonds]
+        #: bond j joins beads bond_first[j] and bond_first[j] + 1
+        self.bond_first = cat([p.bead0 + np.arange(p.N - 1) for p in parts])
+        self.twist_mobility = 1.0 / (self.machin * self.rot_drag[self.free_bonds])  # core
+        # y index of every bead coordinate (3 i + c) and bond twist (3 N + j); -1 if held
+        coord = np.full(3 * self.N + self.N - len(parts), -1, np.int64)
+        coord[(3 * self.free_bead_ids[:, None] + np.arange(3)).ravel()] = np.arange(3 * self.nb)
+        coord[3 * self.N + self.free_bond_ids] = self.sl_th.start + np.arange(self.ne)
+        self._coord_y = coord
 
     def _config_interactions(self) -> list:
         c = self.config.contact
@@ -151,79 +219,96 @@ class RodSystem:
         sc = SelfContact(self.config.filament.cross_section_radius / self.config.filament.length,
                          self.bond, range=c.resolved_self_range,
                          strength=c.resolved_self_strength / self.bond,
-                         c2=1.0 if c.potential == "wca-c2" else 0.0, rest_lengths=self.rest.l0)
+                         c2=1.0 if c.potential == "wca-c2" else 0.0, rest_lengths=self.l0,
+                         chains=None if len(self.parts) == 1 else [p.N for p in self.parts])
         return [SelfContactInteraction(sc)]
 
     # packing -------------------------------------------------------------------------------
     def initial_y(self) -> np.ndarray:
         """The initial state: the rest shape, displaced by ``config.initial`` if it asks
-        (the clamp's beads are not free unknowns, so they stay where the clamp holds them)."""
+        (the clamp's beads are not free unknowns, so they stay where the clamp holds them;
+        filament ``k`` takes the displacement of seed ``initial.seed + k``)."""
         ini = self.config.initial
         if ini.perturbation == 0.0:
             self._check_outside_body(self.x0)
             return self.pack(self.x0, self.theta0, 0.0)
         from flagwrap.geometry.perturbation import displacement
 
-        dx = displacement(self.N, ini.perturbation / self.config.filament.length, ini.mode, ini.seed)
-        dx[:self.nc] = 0.0  # the clamp's beads are where the clamp holds them
+        dx = np.zeros_like(self.x0)
+        for k, p in enumerate(self.parts):
+            d = displacement(p.N, ini.perturbation / self.config.filament.length, ini.mode,
+                             ini.seed + k)
+            d[:p.nc] = 0.0  # the clamp's beads are where the clamp holds them
+            dx[p.beads] = d
         self._check_outside_body(self.x0 + dx)
         return self.pack(self.x0 + dx, self.theta0, 0.0)
 
     def _check_outside_body(self, x) -> None:
         """Refuse a start with a free bead's centre inside the cell body (one line, exit 2)."""
-        d = self.body.distance(x[self.nc:])
+        d = self.body.distance(x[self.free_beads])
         if d.size and d.min() <= 0.0:
             from flagwrap.errors import UserInputError
 
             i = int(np.argmin(d))
             L = self.config.filament.length
             raise UserInputError(
-                f"body overlaps the filament at the start: bead {i + self.nc} is "
+                f"body overlaps the filament at the start: bead {self.free_bead_ids[i]} is "
                 f"{-d[i] * L:.3g} m inside the cell body (initial.perturbation = "
                 f"{self.config.initial.perturbation:g} m, filament.n_beads = "
                 f"{self.config.filament.n_beads}); "
                 "use a smaller initial.perturbation, another initial.seed, or more beads")
 
     def pack(self, x, theta, phi) -> np.ndarray:
+        """``y`` from all beads ``x`` (N, 3), all twist angles and the motor angle(s)."""
         y = np.empty(self.ny)
-        y[self.sl_x] = x[self.nc:].ravel()
-        y[self.sl_th] = theta[self.ec:]
-        y[self.i_phi] = phi
+        y[self.sl_x] = x[self.free_beads].ravel()
+        y[self.sl_th] = theta[self.free_bonds]
+        y[self.sl_phi] = phi
         return y
 
     def unpack(self, y):
-        phi = y[self.i_phi]
+        """``(x (N, 3), theta (N - n_filaments,), phi)``: every filament's beads and bonds in
+        order; ``phi`` the first motor's angle (the motors turn together)."""
         x = np.empty((self.N, 3))
-        x[: self.nc] = self.clamp.positions(phi)
-        x[self.nc:] = y[self.sl_x].reshape(-1, 3)
-        theta = np.empty(self.N - 1)
-        theta[: self.ec] = self.clamp.theta(phi)
-        theta[self.ec:] = y[self.sl_th]
-        return x, theta, phi
+        theta = np.empty(self.N - len(self.parts))
+        for k, p in enumerate(self.parts):
+            phik = y[self.i_phi + k]
+            x[p.bead0:p.bead0 + p.nc] = p.joint.positions(phik)
+            theta[p.bond0:p.bond0 + p.ec] = p.joint.theta(phik)
+        x[self.free_beads] = y[self.sl_x].reshape(-1, 3)
+        theta[self.free_bonds] = y[self.sl_th]
+        return x, theta, y[self.i_phi]
+
+    def bond_lengths(self, x) -> np.ndarray:
+        """Every bond's length, (N - n_filaments,), in the order of ``l0``."""
+        if len(self.parts) == 1:
+            return np.linalg.norm(np.diff(x, axis=0), axis=1)
+        return np.linalg.norm(x[self.bond_first + 1] - x[self.bond_first], axis=1)
 
     # forces --------------------------------------------------------------------------------
-    def _kernel_args(self, base: Frames):
-        r, c, b = self.rest, self.clamp, self.body
-        has_body = not isinstance(b, NoBody)
-        return (self.nc, self.ec, c.x_ref, c.axis, c.theta_ref, c.twist_rate,
-                base.t, base.d1, base.rt, r.l0, r.cbend, r.ctwist, r.angle_law, r.kbar, r.mbar,
-                r.stretch, has_body, b.radius if has_body else 0.0,
-                b.length if has_body else 0.0, b.sigma if has_body else 0.0,
-                b.strength if has_body else 0.0, b.c2 if has_body else 0.0, self.gravity)
-
     def _fused(self, y: np.ndarray, base: Frames):
-        """The fused kernel alone: ``(G, x, theta, gx, gth, d1, rt, dist, E, Ec)``."""
+        """The fused kernel alone, part by part: ``(G, x, theta, gx, gth, d1, rt, dist, E, Ec)``."""
         N = self.N
         G = np.empty(self.ny)
         x = np.empty((N, 3))
-        theta = np.empty(N - 1)
+        theta = np.empty(N - len(self.parts))
         gx = np.empty((N, 3))
-        gth = np.empty(N - 1)
+        gth = np.empty(N - len(self.parts))
         d1 = np.empty_like(base.d1)
         rt = np.empty_like(base.rt)
         dist = np.empty(N)
-        E, Ec = SK.generalized_forces(np.ascontiguousarray(y), *self._kernel_args(base),
-                                      G, x, theta, gx, gth, d1, rt, dist, self.body.shape_code)
+        y = np.ascontiguousarray(y)
+        E = Ec = 0.0
+        for p in self.parts:
+            v, e = p.beads, p.bonds
+            yk, Gk = (y, G) if p.ymap is None else (y[p.ymap], np.empty(p.ny))
+            Ek, Eck = SK.generalized_forces(
+                yk, *p.kernel_args(base, self.body, self._has_body), Gk, x[v], theta[e], gx[v],
+                gth[e], d1[e], rt[v], dist[v], self.body.shape_code)
+            if p.ymap is not None:
+                G[p.ymap] = Gk
+            E += Ek
+            Ec += Eck
         return G, x, theta, gx, gth, d1, rt, dist, E, Ec
 
     def forces(self, y: np.ndarray, base: Frames) -> ForceInfo:
@@ -233,26 +318,25 @@ class RodSystem:
         Ei = 0.0
         if self.interactions:
             gxe = np.zeros((N, 3))
-            gthe = np.zeros(N - 1)
+            gthe = np.zeros(len(theta))
             for it in self.interactions:
                 Ei += it.energy_grad(x, theta, gxe, gthe)
-            G[self.sl_x] -= gxe[self.nc:].ravel()
-            G[self.sl_th] -= gthe[self.ec:]
+            G[self.sl_x] -= gxe[self.free_beads].ravel()
+            G[self.sl_th] -= gthe[self.free_bonds]
             gx += gxe
             gth += gthe
-        t = np.empty((N - 1, 3))
-        SK.unit_tangents(x, t)
+        t = np.empty((len(theta), 3))
+        for p in self.parts:
+            SK.unit_tangents(x[p.beads], t[p.bonds])
         return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist, Ei)
 
     def interaction_jacobian_coo(self, y, which: str = "all"):
         """``-d^2U/dy^2`` of the interactions as triplets over the unknowns; ``which``: "all",
-        "local" or "nonlocal" (by ``nonlocal_hessian``). Clamped coordinates are dropped."""
+        "local" or "nonlocal" (by ``nonlocal_hessian``). Held coordinates are dropped."""
         parts = []
         if not self.interactions:
             return parts
         x, theta, _ = self.unpack(y)
-        N, nc, ec = self.N, self.nc, self.ec
-        x0, t0 = self.sl_x.start, self.sl_th.start
         for it in self.interactions:
             nl = bool(getattr(it, "nonlocal_hessian", False))
             if (which == "local" and nl) or (which == "nonlocal" and not nl):
@@ -261,14 +345,9 @@ class RodSystem:
             if h is None:
                 continue
             r, c, v = (np.asarray(a) for a in h)
-            idx = []
-            for f in (r, c):
-                bead = f < 3 * N
-                yi = np.where(bead, x0 + f - 3 * nc, t0 + (f - 3 * N) - ec)
-                ok = np.where(bead, f // 3 >= nc, (f - 3 * N) >= ec)
-                idx.append((yi, ok))
-            keep = idx[0][1] & idx[1][1]
-            parts.append((idx[0][0][keep].astype(np.int64), idx[1][0][keep].astype(np.int64),
+            yr, yc = self._coord_y[r], self._coord_y[c]
+            keep = (yr >= 0) & (yc >= 0)
+            parts.append((yr[keep].astype(np.int64), yc[keep].astype(np.int64),
                           -np.asarray(v, float)[keep]))
         return parts
 
@@ -279,15 +358,15 @@ class RodSystem:
         x, _, _ = self.unpack(y)
         Fx = G[self.sl_x].reshape(-1, 3)
         apply = self.mobility.apply_single if single else self.mobility.apply
-        out[self.sl_x] = apply(x[self.nc:], Fx).ravel() / self.machin
-        out[self.sl_th] = G[self.sl_th] / (self.machin * self.rot_drag[self.ec:])
-        out[self.i_phi] = 0.0
+        out[self.sl_x] = apply(x[self.free_beads], Fx).ravel() / self.machin
+        out[self.sl_th] = G[self.sl_th] / (self.machin * self.rot_drag[self.free_bonds])
+        out[self.sl_phi] = 0.0
         return out
 
     def velocity(self, y, info: ForceInfo, omega: float) -> np.ndarray:
         """``dy/dt`` at ``y`` from the forces ``info`` already computed there."""
         f = self.apply_mobility(y, info.G)
-        f[self.i_phi] = self.motor_rate(y, info, omega)
+        f[self.sl_phi] = self.motor_rate(y, info, omega)
         return f
 
     def motor_rate(self, y, info: ForceInfo, omega: float) -> float:
@@ -332,6 +411,15 @@ class RodSystem:
         here ``info`` itself)."""
         return info
 
+    def joint_observables(self, info: ForceInfo, m1, m2) -> tuple[float, float, float]:
+        """The first filament's joint angle and torques (:meth:`Joint.observables`) from the
+        lab-frame ``info`` and its material frames ``m1``, ``m2`` (all bonds)."""
+        p = self.parts[0]
+        v, e = p.beads, p.bonds
+        frames = info.frames if len(self.parts) == 1 else Frames(
+            info.frames.t[e], info.frames.d1[e], info.frames.rt[v])
+        return p.joint.observables(info.x[v], info.theta[e], m1[e], m2[e], frames, p.rest)
+
     def local_mobility_diagonal(self) -> np.ndarray:
         """Diagonal of the self (no-HI) mobility in core units, (ny,); 0 for the motor angle."""
         d = np.zeros(self.ny)
@@ -341,8 +429,9 @@ class RodSystem:
 
     def near_field_blocks(self, y: np.ndarray, width: int):
         """Near-field ``Mob`` (core units) for banded solvers: translational 3x3 blocks
-        ``(nb, 2 width + 1, 3, 3)`` between beads at most ``width`` apart along the chain
-        (only the self blocks for a local mobility) and the twist diagonal ``(ne,)``."""
+        ``(nb, 2 width + 1, 3, 3)`` between free beads at most ``width`` apart in y's order
+        (along the chain; only the self blocks for a local mobility) and the twist diagonal
+        ``(ne,)``."""
         if not self.mobility.long_range:  # constant: computed once (HI off, every step)
             Mb = self.__dict__.get("_local_blocks")
             if Mb is None:
@@ -350,7 +439,7 @@ class RodSystem:
                     self.mobility.near_field_blocks(np.zeros((self.nb, 3)), 0) / self.machin)
             return Mb, self.twist_mobility
         x, _, _ = self.unpack(y)
-        Mb = self.mobility.near_field_blocks(x[self.nc:], width)
+        Mb = self.mobility.near_field_blocks(x[self.free_beads], width)
         Mb /= self.machin
         return Mb, self.twist_mobility
 
@@ -369,7 +458,7 @@ class RodSystem:
             if out is None:
                 out = self._mxx_buffer = np.empty((3 * self.nb, 3 * self.nb))
         build = getattr(self.mobility, "stage_matrix", None) if stage else None
-        Mxx = (build or self.mobility.matrix)(x[self.nc:], out=out)
+        Mxx = (build or self.mobility.matrix)(x[self.free_beads], out=out)
         Mxx /= self.machin
         return Mxx, self.twist_mobility
 
@@ -393,83 +482,42 @@ class RodSystem:
         x, _, _ = self.unpack(y)
         Mob = np.zeros((self.ny, self.ny))
         n3 = 3 * self.nb
-        Mob[:n3, :n3] = self.mobility.matrix(x[self.nc:]) / self.machin
+        Mob[:n3, :n3] = self.mobility.matrix(x[self.free_beads]) / self.machin
         idx = np.arange(n3, n3 + self.ne)
         Mob[idx, idx] = self.twist_mobility
         return Mob
 
     # Jacobian by coloured finite differences ------------------------------------------------
-    def _build_colors(self):
-        """Groups of columns whose force stencils are disjoint (5 apart along the chain)."""
-        nb, nc, ec = self.nb, self.nc, self.ec
-        groups = []
-
-        def stencil_rows(beads, bonds):  # the free unknowns among these beads and bonds
-            rows = []
-            for m in beads:
-                if nc <= m < self.N:
-                    rows += [3 * (m - nc) + c for c in range(3)]
-            for j in bonds:
-                if ec <= j < self.N - 1:
-                    rows.append(3 * nb + (j - ec))
-            return rows
-
-        def bead_rows(k):  # k: full bead index; rows affected: beads k-2..k+2, bonds k-2..k+1
-            return stencil_rows(range(k - 2, k + 3), range(k - 2, k + 2))
-
-        def edge_rows(j):  # bond j: beads j-1..j+2, bonds j-1..j+1
-            return stencil_rows(range(j - 1, j + 3), range(j - 1, j + 2))
-
-        def group(members, column, rows_of):  # one colour: columns and their (row, col) pairs
-            cols, rows_l, cols_l = [], [], []
-            for k in members:
-                col = column(k)
-                cols.append(col)
-                rr = rows_of(k)
-                rows_l += rr
-                cols_l += [col] * len(rr)
-            if cols:
-                groups.append((np.array(cols), np.array(rows_l), np.array(cols_l)))
-
-        for start in range(5):
-            for c in range(3):
-                group(range(nc + start, self.N, 5), lambda k, c=c: 3 * (k - nc) + c, bead_rows)
-        for start in range(5):
-            group(range(ec + start, self.N - 1, 5), lambda j: 3 * nb + (j - ec), edge_rows)
-        self._colors = groups
-        g_ptr = np.cumsum([0] + [len(g[0]) for g in groups]).astype(np.int64)
-        e_ptr = np.cumsum([0] + [len(g[1]) for g in groups]).astype(np.int64)
-        self._colors_flat = (
-            g_ptr, np.concatenate([g[0] for g in groups]).astype(np.int64),
-            e_ptr, np.concatenate([g[1] for g in groups]).astype(np.int64),
-            np.concatenate([g[2] for g in groups]).astype(np.int64),
-        )
-
     def force_jacobian_coo(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
                            delta: float | None = None, nonlocal_terms: bool = True):
         """``dG/dy`` as COO triplets (rows, cols, vals; duplicates add), O(N) work and memory.
 
         ``delta``: difference step, default ``fd_step``. ``nonlocal_terms``: include the
         interactions whose Hessians couple beads far apart along the chain (the banded
-        solvers pass False). The interactions' terms are their own Hessians
-        (:meth:`interaction_jacobian_coo`), appended to the kernel's coloured differences.
+        solvers pass False). Each filament's forces depend on its own unknowns only, so its
+        block is the kernel's coloured differences on its unknowns
+        (:meth:`FilamentPart.build_colors`); the interactions' terms are their own Hessians
+        (:meth:`interaction_jacobian_coo`), appended.
         """
         if delta is None:
             delta = self.fd_step
-        if self._colors is None:
-            self._build_colors()
         if self.interactions:  # the kernel differences its own forces: it needs its own G
             G0 = self._fused(y, base)[0]
         elif G0 is None:
             G0 = self.forces(y, base).G
-        g_ptr, g_cols, e_ptr, e_rows, e_cols = self._colors_flat
-        trip = SK.fd_jacobian_coo(np.ascontiguousarray(y), G0, delta, g_ptr, g_cols, e_ptr,
-                                  e_rows, e_cols, self.N, *self._kernel_args(base),
-                                  self.body.shape_code)
-        extra = self.interaction_jacobian_coo(y, "all" if nonlocal_terms else "local")
-        if not extra:
-            return trip
-        return tuple(np.concatenate([trip[k]] + [e[k] for e in extra]) for k in range(3))
+        y = np.ascontiguousarray(y)
+        trips = []
+        for p in self.parts:
+            colors = p.colors or p.build_colors()
+            yk, Gk = (y, G0) if p.ymap is None else (y[p.ymap], G0[p.ymap])
+            r, c, v = SK.fd_jacobian_coo(yk, Gk, delta, *colors, p.N,
+                                         *p.kernel_args(base, self.body, self._has_body),
+                                         self.body.shape_code)
+            trips.append((r, c, v) if p.ymap is None else (p.ymap[r], p.ymap[c], v))
+        trips += self.interaction_jacobian_coo(y, "all" if nonlocal_terms else "local")
+        if len(trips) == 1:
+            return trips[0]
+        return tuple(np.concatenate([t[k] for t in trips]) for k in range(3))
 
     def force_jacobian(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
                        delta: float | None = None) -> np.ndarray:
@@ -489,13 +537,25 @@ class RodSystem:
 
     # observables ---------------------------------------------------------------------------
     def motor_torque(self, info: ForceInfo, phi: float, omega: float) -> float:
-        """Axial torque the motor supplies [A/L], about the outward axis (positive = CCW).
+        """Axial torque the motor supplies [A/L], about the outward axis (positive = CCW);
+        with several filaments, the sum over their motors (:meth:`motor_torques`).
 
         Torque balance on the driven DOF: ``N_m = dE/dphi + zeta_r0 omega`` with
         ``zeta_r0 = M 8 pi a^3 w_0`` the rotational drag of the clamped bond. A torque motor
         exerts its own torque (:mod:`flagwrap.motor.drive`) at the rate it turns.
         """
+        if len(self.parts) > 1:
+            return float(np.sum(self.motor_torques(info, phi, omega)))
         dEdphi = self.clamp.generalized_force(phi, info.grad_x, info.grad_theta)
         if not self.drive.free:
             return dEdphi + self.machin * self.rot_drag[0] * omega
         return self.drive.torque(self.drive.rate(omega, -dEdphi), omega)
+
+    def motor_torques(self, info: ForceInfo, phi: float, omega: float) -> np.ndarray:
+        """Each speed motor's axial torque [A/L] about its own axis, (n_filaments,); the
+        motors turn together, all at angle ``phi``."""
+        if self.drive.free:
+            return np.array([self.motor_torque(info, phi, omega)])
+        return np.array([p.joint.generalized_force(phi, info.grad_x[p.beads],
+                                                   info.grad_theta[p.bonds])
+                         + self.machin * p.rot_drag[0] * omega for p in self.parts])

@@ -1,0 +1,225 @@
+"""The parts of a system: filaments, each on its own motor at its own anchor.
+
+A :class:`FilamentPart` is one flagellum: its stress-free shape (placed at its anchor), its
+joint (clamp or hook), its rest state (per-vertex stiffnesses), its rotational drags and
+gravity, and where its beads, bonds and unknowns sit in the system's arrays. The system
+(:class:`~flagwrap.system.rod_system.RodSystem`) holds a list of them, concatenates their
+beads and bonds (filament ``k`` owns beads ``bead0 .. bead0 + N - 1`` and bonds
+``bond0 .. bond0 + N - 2``) and lays out its unknowns as
+
+    y = [x_free (3 n_b, every filament's free beads in order),
+         theta_free (n_e, every filament's free bonds in order),
+         phi (one motor angle per filament)],
+
+so a single filament's layout is the one the integrators have always read,
+``[x_free, theta_free, phi]``. Each part evaluates its own forces with the fused kernel on
+its own unknowns ``y[part.ymap]`` (in the kernel's order ``[x, theta, phi]``); the parts
+meet through the mobility (one over all free beads) and the interactions (contact).
+
+:class:`Placement` puts the default shape (built at the origin, motor axis ``-z``, the body
+above) at an anchor on the body surface with its motor axis along the surface normal
+(:func:`cap_placement` on the capped cylinder's pole cap).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from flagwrap.elasticity.rod import initial_frames, rest_state
+
+#: the default shape's motor axis (out of the body's lowest point, down the body axis)
+DEFAULT_AXIS = np.array([0.0, 0.0, -1.0])
+
+
+@dataclass(frozen=True)
+class Placement:
+    """A rigid placement ``x -> origin + R x`` of the default shape: its anchor ``origin``
+    [L] and rotation ``R`` (3, 3); the motor axis becomes ``R (0, 0, -1)``."""
+
+    origin: tuple = (0.0, 0.0, 0.0)
+    rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+    @property
+    def R(self) -> np.ndarray:
+        return np.asarray(self.rotation, float)
+
+    @property
+    def axis(self) -> np.ndarray:
+        return self.R @ DEFAULT_AXIS
+
+    @property
+    def identity(self) -> bool:
+        return not np.any(self.origin) and np.array_equal(self.R, np.eye(3))
+
+    def apply(self, x: np.ndarray) -> np.ndarray:
+        """The shape ``x`` (n, 3) placed (the identity returns ``x`` itself, bit for bit)."""
+        if self.identity:
+            return x
+        return np.asarray(self.origin, float) + x @ self.R.T
+
+    @classmethod
+    def from_axis(cls, origin, axis, spin: float = 0.0) -> "Placement":
+        """The placement with anchor ``origin`` and motor axis ``axis`` (any length > 0): the
+        default shape turned by ``spin`` [rad] about its own axis, then tilted from ``-z`` to
+        ``axis`` about ``-z x axis`` (the shortest rotation)."""
+        a = np.asarray(axis, float)
+        n = np.linalg.norm(a)
+        if not (np.all(np.isfinite(a)) and n > 0):
+            raise ValueError(f"Placement: the motor axis must be a finite non-zero vector, got {axis!r}")
+        a = a / n
+        c, s = math.cos(spin), math.sin(spin)
+        Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        k = np.cross(DEFAULT_AXIS, a)
+        sk, ck = np.linalg.norm(k), float(DEFAULT_AXIS @ a)
+        if sk < 1e-15:
+            T = np.eye(3) if ck > 0 else np.diag([1.0, -1.0, -1.0])
+        else:
+            k = k / sk
+            K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+            T = np.eye(3) + sk * K + (1.0 - ck) * (K @ K)
+        R = T @ Rz
+        return cls(tuple(float(v) for v in origin), tuple(tuple(float(v) for v in r) for r in R))
+
+
+def cap_placement(cap_radius: float, polar: float, azimuth: float, spin: float | None = None
+                  ) -> Placement:
+    """An anchor on the pole cap of the capped cylinder (body axis ``z``, the cap's lowest
+    point at the origin, its centre at ``(0, 0, cap_radius)``): at ``polar`` [rad] from the
+    pole and ``azimuth`` [rad] about the body axis, motor axis along the outward normal.
+    ``spin`` (default ``azimuth``) turns the shape about its own axis, so that anchors spread
+    by azimuth carry copies of one shape turned about the body axis (a symmetric tuft)."""
+    n = np.array([math.sin(polar) * math.cos(azimuth), math.sin(polar) * math.sin(azimuth),
+                  -math.cos(polar)])
+    origin = np.array([0.0, 0.0, cap_radius]) + cap_radius * n
+    return Placement.from_axis(origin, n, azimuth if spin is None else spin)
+
+
+class FilamentPart:
+    """One filament of the system (module docstring), in core units.
+
+    ``x0``, ``theta0``: its stress-free shape, already placed and with the joint's beads
+    (``joint``, from :func:`flagwrap.joints.make_joint` on that shape). ``bond``: the
+    nominal bond ``b`` [L]; ``twist``, ``stretch``: ``C/A`` and the stretching stiffness
+    [A/L^2 per b^3]; ``radius``: the bead's hydrodynamic radius [L]; ``gravity_number``: ``G``
+    or None (no buoyancy).
+    """
+
+    def __init__(self, x0, theta0, joint, *, bond: float, twist: float, stretch: float,
+                 radius: float, gravity_number=None, name: str = "flagellum"):
+        self.name = str(name)
+        self.x0 = np.asarray(x0, float)
+        self.theta0 = np.asarray(theta0, float)
+        N = len(self.x0)
+        self.N = N
+        self.frames0 = initial_frames(self.x0)
+        self.joint = joint
+        self.rest = joint.rest(rest_state(self.x0, self.frames0, self.theta0, bending=1.0,
+                                          twist=twist, stretch=stretch))
+        self.nc, self.ec = joint.n_beads, joint.n_edges
+        self.nb = N - self.nc  # free beads
+        self.ne = N - 1 - self.ec  # free bonds
+        # each bead's rotational drag 8 pi eta a^3 is shared by its two bonds (docs/model.md)
+        w = np.ones(N - 1)
+        w[0] += 0.5
+        w[-1] += 0.5
+        self.rot_drag = 8.0 * math.pi * radius**3 * w  # geometric; times M gives core drag
+        # gravity/buoyancy: force per bead (core units) along +z, G l / L for a bead carrying
+        # contour l (half a bond at the ends): units.gravity_number
+        self.gravity = np.zeros((N, 3))
+        if gravity_number is not None:
+            # half of each adjacent bond's nominal length (b, or a hook's short bonds)
+            lb = np.where(np.abs(self.rest.l0 - bond) < 1e-9 * bond, bond, self.rest.l0)
+            per_bead = np.empty(N)
+            per_bead[0], per_bead[-1] = 0.5 * lb[0], 0.5 * lb[-1]
+            per_bead[1:-1] = 0.5 * (lb[:-1] + lb[1:])
+            self.gravity[:, 2] = gravity_number * per_bead
+        # set by the system when it assembles its parts (assign_offsets)
+        self.bead0 = self.bond0 = 0
+        self.ymap = None
+        self.colors = None
+
+    @property
+    def beads(self) -> slice:
+        """This filament's beads in the system's bead arrays."""
+        return slice(self.bead0, self.bead0 + self.N)
+
+    @property
+    def bonds(self) -> slice:
+        """This filament's bonds in the system's bond arrays."""
+        return slice(self.bond0, self.bond0 + self.N - 1)
+
+    @property
+    def ny(self) -> int:
+        """Its own unknowns ``[x_free, theta_free, phi]``."""
+        return 3 * self.nb + self.ne + 1
+
+    def assign_offsets(self, bead0: int, bond0: int, free_bead0: int, free_bond0: int,
+                       theta_start: int, phi_index: int, single: bool) -> None:
+        """Where its beads, bonds and unknowns sit in the system (module docstring);
+        ``single``: the only part, whose unknowns are the system's in the same order."""
+        self.bead0, self.bond0 = int(bead0), int(bond0)
+        self.ymap = None if single else np.concatenate([
+            np.arange(3 * free_bead0, 3 * (free_bead0 + self.nb)),
+            np.arange(theta_start + free_bond0, theta_start + free_bond0 + self.ne),
+            [phi_index]]).astype(np.int64)
+
+    def kernel_args(self, base, body, has_body: bool):
+        """The fused kernel's arguments after ``y`` (:mod:`flagwrap.system.kernels`), the
+        reference frames ``base`` being the system's (this part's rows are taken)."""
+        r, c, b = self.rest, self.joint, body
+        e, v = self.bonds, self.beads
+        return (self.nc, self.ec, c.x_ref, c.axis, c.origin, c.theta_ref, c.twist_rate,
+                base.t[e], base.d1[e], base.rt[v], r.l0, r.cbend, r.ctwist, r.angle_law,
+                r.kbar, r.mbar, r.stretch, has_body, b.radius if has_body else 0.0,
+                b.length if has_body else 0.0, b.sigma if has_body else 0.0,
+                b.strength if has_body else 0.0, b.c2 if has_body else 0.0, self.gravity)
+
+    def build_colors(self):
+        """Groups of its own unknowns whose force stencils are disjoint (5 apart along the
+        chain), flattened for :func:`flagwrap.system.kernels.fd_jacobian_coo`."""
+        nb, nc, ec, N = self.nb, self.nc, self.ec, self.N
+        groups = []
+
+        def stencil_rows(beads, bonds):  # the free unknowns among these beads and bonds
+            rows = []
+            for m in beads:
+                if nc <= m < N:
+                    rows += [3 * (m - nc) + c for c in range(3)]
+            for j in bonds:
+                if ec <= j < N - 1:
+                    rows.append(3 * nb + (j - ec))
+            return rows
+
+        def bead_rows(k):  # k: bead index; rows affected: beads k-2..k+2, bonds k-2..k+1
+            return stencil_rows(range(k - 2, k + 3), range(k - 2, k + 2))
+
+        def edge_rows(j):  # bond j: beads j-1..j+2, bonds j-1..j+1
+            return stencil_rows(range(j - 1, j + 3), range(j - 1, j + 2))
+
+        def group(members, column, rows_of):  # one colour: columns and their (row, col) pairs
+            cols, rows_l, cols_l = [], [], []
+            for k in members:
+                col = column(k)
+                cols.append(col)
+                rr = rows_of(k)
+                rows_l += rr
+                cols_l += [col] * len(rr)
+            if cols:
+                groups.append((np.array(cols), np.array(rows_l), np.array(cols_l)))
+
+        for start in range(5):
+            for c in range(3):
+                group(range(nc + start, N, 5), lambda k, c=c: 3 * (k - nc) + c, bead_rows)
+        for start in range(5):
+            group(range(ec + start, N - 1, 5), lambda j: 3 * nb + (j - ec), edge_rows)
+        g_ptr = np.cumsum([0] + [len(g[0]) for g in groups]).astype(np.int64)
+        e_ptr = np.cumsum([0] + [len(g[1]) for g in groups]).astype(np.int64)
+        self.colors = (
+            g_ptr, np.concatenate([g[0] for g in groups]).astype(np.int64),
+            e_ptr, np.concatenate([g[1] for g in groups]).astype(np.int64),
+            np.concatenate([g[2] for g in groups]).astype(np.int64),
+        )
+        return self.colors
