@@ -203,7 +203,8 @@ class RodSystem:
         self.free_bond_ids = np.arange(self.N - len(parts))[self.free_bonds]
         #: bond j joins beads bond_first[j] and bond_first[j] + 1
         self.bond_first = cat([p.bead0 + np.arange(p.N - 1) for p in parts])
-        self.twist_mobility = 1.0 / (self.machin * self.rot_drag[self.free_bonds])  # core
+        self._rot_drag_free = self.rot_drag[self.free_bonds]  # once: no indexing per product
+        self.twist_mobility = 1.0 / (self.machin * self._rot_drag_free)  # core
         # y index of every bead coordinate (3 i + c) and bond twist (3 N + j); -1 if held
         coord = np.full(3 * self.N + self.N - len(parts), -1, np.int64)
         coord[(3 * self.free_bead_ids[:, None] + np.arange(3)).ravel()] = np.arange(3 * self.nb)
@@ -359,7 +360,7 @@ class RodSystem:
         Fx = G[self.sl_x].reshape(-1, 3)
         apply = self.mobility.apply_single if single else self.mobility.apply
         out[self.sl_x] = apply(x[self.free_beads], Fx).ravel() / self.machin
-        out[self.sl_th] = G[self.sl_th] / (self.machin * self.rot_drag[self.free_bonds])
+        out[self.sl_th] = G[self.sl_th] / (self.machin * self._rot_drag_free)
         out[self.sl_phi] = 0.0
         return out
 
