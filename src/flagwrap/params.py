@@ -565,6 +565,55 @@ class Joint:
 
 
 @dataclass(frozen=True)
+class Flagellum:
+    """Where one flagellum sits on the cell body (issue 28; ``[[flagellum]]`` tables, one per
+    flagellum; docs/bundle.md). Every flagellum is a copy of ``[filament]`` on its own
+    ``[joint]`` and motor; no table is one flagellum at the pole, as before.
+
+    Either on the pole cap of a "capped-cylinder" or "sphere" body: ``polar_deg`` [deg] from
+    the pole (0 = the pole, the single flagellum's place; < 90, on the cap) and
+    ``azimuth_deg`` [deg] about the body axis; the motor axis along the outward normal. Or
+    anywhere (any body, or none): ``anchor`` [m, length unit], the point on the body surface
+    where the motor holds the filament, and ``axis``, the motor axis (pointing out of the
+    body). ``spin_deg`` [deg] turns the filament's shape about its motor axis (default: the
+    azimuth, so that anchors spread by azimuth carry copies of one shape turned about the
+    body axis: a symmetric tuft).
+    """
+
+    polar_deg: float | None = None
+    azimuth_deg: float | None = None
+    spin_deg: float | None = None
+    anchor: tuple | None = None
+    axis: tuple | None = None
+
+    def __post_init__(self, where: str = "flagellum"):
+        on_cap = self.polar_deg is not None or self.azimuth_deg is not None
+        if on_cap and (self.anchor is not None or self.axis is not None):
+            raise UserInputError(f"{where}: give polar_deg/azimuth_deg (on the pole cap) or "
+                                 "anchor/axis (anywhere), not both")
+        if not on_cap and (self.anchor is None or self.axis is None):
+            missing = "anchor" if self.anchor is None else "axis"
+            raise UserInputError(f"{where}.{missing} is missing: give polar_deg (and "
+                                 "azimuth_deg) on the pole cap, or anchor and axis")
+        if on_cap:
+            polar = _finite(f"{where}.polar_deg", 0.0 if self.polar_deg is None else self.polar_deg)
+            if not 0.0 <= polar < 90.0:
+                raise UserInputError(f"{where}.polar_deg must be in [0, 90) deg (on the pole "
+                                     f"cap), got {self.polar_deg!r}")
+            _finite(f"{where}.azimuth_deg", 0.0 if self.azimuth_deg is None else self.azimuth_deg)
+        else:
+            for key in ("anchor", "axis"):
+                v = getattr(self, key)
+                if not (isinstance(v, (list, tuple)) and len(v) == 3):
+                    raise UserInputError(f"{where}.{key} must be 3 numbers [x, y, z], got {v!r}")
+                _set(self, key, tuple(_finite(f"{where}.{key}", c) for c in v))
+            if not any(self.axis):
+                raise UserInputError(f"{where}.axis must not be zero")
+        if self.spin_deg is not None:
+            _finite(f"{where}.spin_deg", self.spin_deg)
+
+
+@dataclass(frozen=True)
 class Contact:
     """Short-ranged repulsion between beads and the cell body (WCA form).
 
@@ -791,6 +840,8 @@ class Config:
     clamp: Clamp = field(default_factory=Clamp)
     initial: Initial = field(default_factory=Initial)
     joint: Joint = field(default_factory=Joint)
+    #: one per flagellum (``[[flagellum]]``); empty: one flagellum at the pole
+    flagella: tuple = ()
     name: str = "run"
 
     def __post_init__(self):
@@ -807,6 +858,10 @@ class Config:
         ):
             if not isinstance(getattr(self, attr), cls):
                 raise UserInputError(f"config.{attr} must be a {cls.__name__}")
+        _set(self, "flagella", tuple(self.flagella))
+        for k, f in enumerate(self.flagella):
+            if not isinstance(f, Flagellum):
+                raise UserInputError(f"config.flagella[{k}] must be a Flagellum")
         fil = self.filament
         if fil.density_mismatch is not None:
             # resolved to a density here, where the fluid's is known (as pitch-like inputs
@@ -829,6 +884,10 @@ class Config:
                     f"{how} gives a cell body of radius {rc:.3g} m; it must be wider than the "
                     f"filament (> 2 a = {2 * a:.3g} m) and at most {MAX_BODY_OVER_LENGTH:g} L = "
                     f"{MAX_BODY_OVER_LENGTH * fil.length:.3g} m (or set body.enabled = false)")
+        if self.flagella:
+            from flagwrap.system.parts import check_flagella
+
+            check_flagella(self)
         if self.body.no_slip or self.body.free:
             self._check_surface_body()
         if self.motor.kind != "speed":
@@ -994,6 +1053,10 @@ class Config:
             return obj
 
         d = clean(self)
+        # one table per flagellum, as the TOML has them ([[flagellum]]); none: the default
+        fl = d.pop("flagella", [])
+        if fl:
+            d["flagellum"] = fl
         # pitch-like inputs are all stored after resolution; keep only pitch (canonical)
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)
@@ -1007,6 +1070,7 @@ class Config:
                 d.pop("joint", None)
             if not self.contact.self_contact:
                 d["contact"].pop("self_contact", None)
+
             for section, cls in (("numerics", Numerics), ("body", CellBody), ("motor", Motor)):
                 for k, v in cls.HASH_OMIT_DEFAULTS.items():
                     if d[section].get(k) == v:

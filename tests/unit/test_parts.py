@@ -147,3 +147,124 @@ def test_placement_turns_the_default_axis_onto_the_given_one():
         assert np.linalg.det(p.R) == pytest.approx(1.0)
     with pytest.raises(ValueError, match="motor axis"):
         Placement.from_axis((0, 0, 0), (0, 0, 0))
+
+
+# ---- the config's [[flagellum]] tables -------------------------------------------------------
+
+TWO = """
+name = "two"
+[filament]
+length = 0.4
+helix_radius = 0.03
+turns = 2
+cross_section_radius = 0.0015
+youngs_modulus = 1.5e6
+n_beads = 21
+[motor]
+machin = 283
+protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.1}]
+"""
+
+
+def _load(text):
+    import tomllib
+
+    from flagwrap.io.config import config_from_dict
+
+    return config_from_dict(tomllib.loads(text))
+
+
+def test_tables_place_the_flagella_and_read_back():
+    from flagwrap.io.config import config_to_toml
+
+    cfg = _load(TWO + "[[flagellum]]\npolar_deg = 35\n[[flagellum]]\npolar_deg = 35\n"
+                "azimuth_deg = 180\n")
+    s = RodSystem(cfg)
+    assert s.n_filaments == 2
+    ref = RodSystem(cfg, placements=_tuft(cfg, 2))
+    assert np.array_equal(s.x0, ref.x0)
+    assert _load(config_to_toml(cfg)) == cfg
+
+
+def test_one_table_at_the_pole_is_the_config_without_tables():
+    from flagwrap.simulation import simulate
+
+    a = simulate(_load(TWO))
+    b = simulate(_load(TWO + "[[flagellum]]\npolar_deg = 0\n"))
+    assert a.ok and b.ok
+    for k in ("t", "x", "theta", "motor_torque"):
+        assert np.array_equal(np.asarray(getattr(a, k)), np.asarray(getattr(b, k))), k
+
+
+def test_free_cell_with_three_flagella_exerts_no_force_or_torque_on_the_fluid(rng):
+    # blob forces + bead forces + bond torques on the fluid sum to zero (the cell is force-
+    # and torque-free), for an asymmetric tuft; round-off of sums of O(|F|) terms
+    from flagwrap.simulation import make_system
+
+    cfg = _load(TWO + "[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n"
+                + "".join(f"[[flagellum]]\npolar_deg = 30\nazimuth_deg = {az}\n"
+                          for az in (0, 100, 230)))
+    s = make_system(cfg)
+    assert s.n_filaments == 3
+    y = s.initial_y()
+    y[s.sl_x] += 0.01 * s.bond * rng.standard_normal(s.sl_x.stop - s.sl_x.start)
+    y[s.sl_th] += 0.1 * rng.standard_normal(s.sl_th.stop - s.sl_th.start)
+    info = s.forces(y, s.frames0)
+    V, v, lam = s.body_velocity(y, info.G)
+    x, _, _ = s.unpack(y)
+    xf = x[s.free_beads]
+    F = info.G[s.sl_x].reshape(-1, 3)
+    tau = info.G[s.sl_th]
+    bf = s.bond_first[s.free_bonds]
+    t = (x[bf + 1] - x[bf]) / np.linalg.norm(x[bf + 1] - x[bf], axis=1)[:, None]
+    L = lam.reshape(-1, 3)
+    tot_f = F.sum(axis=0) + L.sum(axis=0)
+    tot_t = np.cross(xf, F).sum(axis=0) + tau @ t + np.cross(s.blobs, L).sum(axis=0)
+    assert np.abs(tot_f).max() < 1e-10 * np.abs(F).sum()
+    assert np.abs(tot_t).max() < 1e-10 * (np.abs(np.cross(xf, F)).sum() + np.abs(tau).sum())
+    assert np.abs(V).max() > 0
+
+
+@pytest.mark.parametrize("tables, match", [
+    ("flagellum = []\n", "zero flagella"),
+    ("[[flagellum]]\nazimuth_deg = 10\nspin = 1\n", r"unknown key flagellum\[0\].spin"),
+    ("[[flagellum]]\nanchor = [0.0, 0.0, 0.0]\n", r"flagellum\[0\].axis is missing"),
+    ("[[flagellum]]\npolar_deg = 95\n", r"flagellum\[0\].polar_deg must be in \[0, 90\)"),
+    ("[[flagellum]]\nanchor = [0.01, 0.0, 0.0]\naxis = [0, 0, -1]\n",
+     r"flagellum\[0\].anchor = .* from the body surface"),
+    ("[[flagellum]]\nanchor = [0.0, 0.0, 0.0]\naxis = [0, 0, 1]\n",
+     r"flagellum\[0\].axis = .* points into the body"),
+    ("[[flagellum]]\npolar_deg = 20\n[[flagellum]]\npolar_deg = 20\nazimuth_deg = 1\n",
+     r"flagellum\[1\] and flagellum\[0\] are anchored"),
+    # copies of one shape not turned with their azimuth (spin 0): the helices meet
+    ("[[flagellum]]\npolar_deg = 10\nspin_deg = 0\n[[flagellum]]\npolar_deg = 10\n"
+     "azimuth_deg = 30\nspin_deg = 0\n", r"flagellum\[1\] and flagellum\[0\] cross at the start"),
+    ("[body]\nshape = 'spheroid'\n[[flagellum]]\npolar_deg = 10\n",
+     r"flagellum\[0\].polar_deg places the flagellum on a spherical pole cap"),
+    ("[numerics]\nframe = 'rotating'\n[[flagellum]]\npolar_deg = 35\n[[flagellum]]\n"
+     "polar_deg = 35\nazimuth_deg = 180\n", "numerics.frame = 'rotating' needs one flagellum"),
+])
+def test_bad_flagellum_tables_are_one_line_exit_2(tmp_path, capsys, tables, match):
+    import re
+
+    from flagwrap.cli.main import main
+
+    p = tmp_path / "bad.toml"
+    # a top-level key must come before the tables
+    p.write_text(tables + TWO if tables.startswith("flagellum =") else TWO + tables)
+    out = tmp_path / "out.nc"
+    assert main(["run", str(p), "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and re.search(match, err), err
+    assert not out.exists()
+
+
+def test_stability_refuses_several_flagella_by_name(tmp_path, capsys):
+    from flagwrap.cli.main import main
+
+    p = tmp_path / "two.toml"
+    p.write_text(TWO + "[[flagellum]]\npolar_deg = 35\n[[flagellum]]\npolar_deg = 35\n"
+                 "azimuth_deg = 180\n")
+    assert main(["stability", str(p)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "turning frame" in err and "needs one flagellum" in err and len(err.splitlines()) == 1

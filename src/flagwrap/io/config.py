@@ -24,8 +24,8 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from flagwrap.errors import UserInputError
-from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Fluid, Initial, Joint,
-                             Motor, Numerics, Phase)
+from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Flagellum, Fluid,
+                             Initial, Joint, Motor, Numerics, Phase)
 
 _SECTIONS = {
     "filament": Filament,
@@ -92,7 +92,7 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
     if not isinstance(data, dict):
         raise UserInputError("config must be a TOML table")
     data = dict(data)
-    allowed_top = set(_SECTIONS) | {"units", "name"}
+    allowed_top = set(_SECTIONS) | {"units", "name", "flagellum"}
     for key in data:
         if key not in allowed_top:
             raise UserInputError(f"unknown section or key {key!r}; allowed: {', '.join(sorted(allowed_top))}")
@@ -150,10 +150,40 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
             msg = str(exc)
             missing = msg.split("argument")[-1].strip(": ") if "missing" in msg else msg
             raise UserInputError(f"[{section}] is missing required value(s): {missing}") from None
+    if "flagellum" in data:
+        kwargs["flagella"] = _flagella(data["flagellum"], lf)
     nm = data.get("name", name or "run")
     if not isinstance(nm, str) or not nm:
         raise UserInputError("name must be a non-empty string")
     return Config(name=nm, **kwargs)
+
+
+def _flagella(tables, lf: float) -> tuple:
+    """``[[flagellum]]`` tables -> :class:`~flagwrap.params.Flagellum` s (``anchor`` in the
+    length unit ``lf``); a problem names the table, ``flagellum[k].key``."""
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        raise UserInputError("flagellum must be an array of tables: [[flagellum]] per flagellum")
+    if not tables:
+        raise UserInputError("flagellum = []: zero flagella; give at least one [[flagellum]] "
+                             "table, or none for one flagellum at the pole")
+    known = _fields(Flagellum)
+    out = []
+    for k, t in enumerate(tables):
+        where = f"flagellum[{k}]"
+        for key, value in t.items():
+            if key not in known:
+                raise UserInputError(f"unknown key {where}.{_show(key)}; allowed: "
+                                     f"{', '.join(sorted(known))}")
+            if isinstance(value, dict) or (isinstance(value, list) and key not in ("anchor", "axis")):
+                raise UserInputError(f"{where}.{key} must be a single value")
+        t = dict(t)
+        if isinstance(t.get("anchor"), list) and all(_is_number(c) for c in t["anchor"]):
+            t["anchor"] = [c * lf for c in t["anchor"]]
+        try:
+            out.append(Flagellum(**t))
+        except UserInputError as exc:
+            raise UserInputError(str(exc).replace("flagellum", where, 1)) from None
+    return tuple(out)
 
 
 def load_config(path) -> Config:
@@ -207,6 +237,14 @@ def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
                     for p in v
                 )
                 lines.append(f"protocol = [{items}]")
+            else:
+                lines.append(f"{k} = {_toml_value(v)}")
+        lines.append("")
+    for table in d.get("flagellum", []):
+        lines.append("[[flagellum]]")
+        for k, v in table.items():
+            if isinstance(v, (list, tuple)):
+                lines.append(f"{k} = [{', '.join(_toml_value(c) for c in v)}]")
             else:
                 lines.append(f"{k} = {_toml_value(v)}")
         lines.append("")

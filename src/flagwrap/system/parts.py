@@ -223,3 +223,93 @@ class FilamentPart:
             np.concatenate([g[2] for g in groups]).astype(np.int64),
         )
         return self.colors
+
+
+def placements_from_config(config) -> list | None:
+    """One :class:`Placement` per ``[[flagellum]]`` table (core units), or None (no table:
+    one flagellum at the pole, the identity)."""
+    if not config.flagella:
+        return None
+    L = config.filament.length
+    out = []
+    for f in config.flagella:
+        spin = None if f.spin_deg is None else math.radians(f.spin_deg)
+        if f.anchor is None:
+            Rc = config.body.resolved_radius(config.filament.helix_radius) / L
+            out.append(cap_placement(Rc, math.radians(f.polar_deg or 0.0),
+                                     math.radians(f.azimuth_deg or 0.0), spin))
+        else:
+            out.append(Placement.from_axis(np.asarray(f.anchor, float) / L, f.axis, spin or 0.0))
+    return out
+
+
+def check_flagella(config) -> None:
+    """Refuse ``[[flagellum]]`` tables that cannot be built (one line naming the table and
+    key, before any work): a cap anchor without a spherical pole cap, an anchor off the body
+    surface or an axis into the body, anchors closer than a filament's diameter, filaments
+    whose stress-free shapes cross, a turning frame with several flagella or one off the
+    body axis."""
+    from flagwrap.errors import UserInputError
+    from flagwrap.geometry.helix import filament_positions
+    from flagwrap.observables.contact import body_distance
+
+    fil, body = config.filament, config.body
+    L, a = fil.length, fil.cross_section_radius
+    Rc = body.resolved_radius(fil.helix_radius)
+    H = body.resolved_length(fil.helix_radius)
+    for k, f in enumerate(config.flagella):
+        where = f"flagellum[{k}]"
+        if f.anchor is None and not (body.enabled and body.shape in ("capped-cylinder", "sphere")):
+            raise UserInputError(
+                f"{where}.polar_deg places the flagellum on a spherical pole cap: it needs "
+                "body.enabled = true and body.shape = 'capped-cylinder' or 'sphere' (this body: "
+                f"{body.shape if body.enabled else 'none'}); give {where}.anchor and axis instead")
+        if f.anchor is not None and body.enabled:
+            p = np.asarray(f.anchor, float)
+            d = float(body_distance(p[None], Rc, H, body.shape)[0])
+            if abs(d) > 0.1 * a:
+                raise UserInputError(
+                    f"{where}.anchor = {list(f.anchor)} m is {d:.3g} m from the body surface; it "
+                    f"must lie on it (within 0.1 a = {0.1 * a:.3g} m)")
+            h = 1e-3 * Rc
+            n = np.array([(body_distance((p + h * e)[None], Rc, H, body.shape)[0]
+                           - body_distance((p - h * e)[None], Rc, H, body.shape)[0]) / (2 * h)
+                          for e in np.eye(3)])
+            if not float(n @ np.asarray(f.axis, float)) > 0.0:
+                raise UserInputError(f"{where}.axis = {list(f.axis)} points into the body; the "
+                                     "motor axis must point out of it")
+    if len(config.flagella) > 1 and config.numerics.frame != "lab":
+        raise UserInputError(f"numerics.frame = {config.numerics.frame!r} needs one flagellum on "
+                             f"the motor axis; this config has {len(config.flagella)} "
+                             "[[flagellum]] tables: use numerics.frame = 'lab'")
+    places = placements_from_config(config)
+    shape = filament_positions(fil, config.clamp) / L
+    shapes = [pl.apply(shape) for pl in places]
+    for k in range(len(shapes)):
+        for m in range(k):
+            gap = np.linalg.norm(shapes[k][0] - shapes[m][0]) * L
+            if gap < 2 * a:
+                raise UserInputError(
+                    f"flagellum[{k}] and flagellum[{m}] are anchored {gap:.3g} m apart, less "
+                    f"than the filament's diameter 2 a = {2 * a:.3g} m: move one")
+            d = _min_segment_distance(shapes[k], shapes[m]) * L
+            if d < 2 * a:
+                raise UserInputError(
+                    f"flagellum[{k}] and flagellum[{m}] cross at the start: their stress-free "
+                    f"shapes come {d:.3g} m close, less than 2 a = {2 * a:.3g} m (spread the "
+                    "anchors: polar_deg, azimuth_deg, or turn one: spin_deg)")
+
+
+def _min_segment_distance(x, z) -> float:
+    """The smallest distance between a segment of chain ``x`` and one of chain ``z``."""
+    from flagwrap.interactions.self_contact import segment_closest
+
+    best = np.inf
+    # bounding-sphere prefilter, then the exact segment distance
+    cx, hx = 0.5 * (x[1:] + x[:-1]), 0.5 * np.linalg.norm(np.diff(x, axis=0), axis=1)
+    cz, hz = 0.5 * (z[1:] + z[:-1]), 0.5 * np.linalg.norm(np.diff(z, axis=0), axis=1)
+    lower = np.linalg.norm(cx[:, None] - cz[None], axis=2) - hx[:, None] - hz[None]
+    for i, j in np.argwhere(lower < max(np.min(lower), 0.0) + 4 * hx.max()):
+        s, t, dx, dy, dz = segment_closest(x[i], x[i + 1], z[j], z[j + 1])
+        best = min(best, float(np.sqrt(dx * dx + dy * dy + dz * dz)))
+    return best

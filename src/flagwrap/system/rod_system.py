@@ -35,7 +35,7 @@ from flagwrap.joints import make_joint
 from flagwrap.motor.drive import make_drive
 from flagwrap.motor.protocol import Schedule
 from flagwrap.system.layout import DofLayout
-from flagwrap.system.parts import FilamentPart, Placement
+from flagwrap.system.parts import FilamentPart, Placement, placements_from_config
 
 
 @dataclass
@@ -94,14 +94,16 @@ class RodSystem:
         :func:`flagwrap.joints.make_joint` from ``config.joint``); ``interactions``: extra
         energy terms (:mod:`flagwrap.interactions.base`) after those the config asks for;
         ``placements``: one :class:`~flagwrap.system.parts.Placement` per filament (default:
-        one filament at the origin), each a copy of the config's filament and joint on its
+        the config's ``[[flagellum]]`` tables, or one filament at the origin), each a copy of the config's filament and joint on its
         own speed motor (the motors turn together, by ``config.motor``'s protocol)."""
         self.config = config
         fil = config.filament
         L = fil.length
         self.scales = config.scales
         self.machin = config.machin
-        placements = [Placement()] if placements is None else list(placements)
+        if placements is None:  # the config's [[flagellum]] tables, or one at the pole
+            placements = placements_from_config(config) or [Placement()]
+        placements = list(placements)
         if not placements:
             raise ValueError("RodSystem: placements must hold at least one filament")
         if len(placements) > 1 and (x0 is not None or (joint or clamp) is not None):

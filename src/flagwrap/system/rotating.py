@@ -60,6 +60,11 @@ def check_rotating_frame(system, blob_body: bool = False) -> None:
     naming the part that breaks the symmetry about the motor axis). ``blob_body``: accept a
     no-slip blob body as if it were symmetric (its blobs held at one angle in the turning
     frame: the linear-stability approximation of :class:`RotatingFrame`)."""
+    parts = getattr(system, "parts", ())
+    if len(parts) > 1:
+        raise UserInputError(
+            f"the turning frame (numerics.frame = 'rotating', flagwrap stability) needs one "
+            f"flagellum on the motor axis; this system has {len(parts)} ([[flagellum]] tables)")
     joint = system.joint
     axis = getattr(joint, "axis", None)
     if axis is None or not hasattr(joint, "x_ref"):

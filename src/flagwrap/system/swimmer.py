@@ -155,8 +155,12 @@ class SwimmerSystem:
         from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
 
         x, _, _ = s.unpack(yin)
-        xf = np.array(x[s.nc:])  # a copy: kept with the cache, never a view of the caller's y
-        e = x[s.ec + 1:] - x[s.ec:-1]
+        xf = np.array(x[s.free_beads])  # a copy: kept with the cache, never a view of y
+        if s.n_filaments == 1:
+            e = x[s.ec + 1:] - x[s.ec:-1]
+        else:  # every filament's free bonds
+            bf = s.bond_first[s.free_bonds]
+            e = x[bf + 1] - x[bf]
         t = e / np.linalg.norm(e, axis=1)[:, None]
         rpy_cross_radii(xf, s.radius, self.blobs, self.blob_radii, self._cross)
         self._geometry_y = np.array(yin)
@@ -211,7 +215,7 @@ class SwimmerSystem:
 
     def velocity(self, y, info, omega: float) -> np.ndarray:
         f = self.apply_mobility(y, info.G)
-        f[self.inner.i_phi] = self.inner.motor_rate(y, info, omega)
+        f[self.inner.sl_phi] = self.inner.motor_rate(y, info, omega)
         return f
 
     def rhs(self, y, base, omega):
