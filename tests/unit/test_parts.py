@@ -268,3 +268,16 @@ def test_stability_refuses_several_flagella_by_name(tmp_path, capsys):
     assert main(["stability", str(p)]) == 2
     err = capsys.readouterr().err.strip()
     assert "turning frame" in err and "needs one flagellum" in err and len(err.splitlines()) == 1
+
+
+def test_turning_frame_refuses_one_flagellum_off_the_body_axis(tmp_path, capsys):
+    # no body: an anchor anywhere, its motor axis along -z but 5 cm beside the body axis
+    from flagwrap.cli.main import main
+
+    p = tmp_path / "off.toml"
+    p.write_text(TWO + "[body]\nenabled = false\n[numerics]\nframe = 'rotating'\n"
+                 "[[flagellum]]\nanchor = [0.05, 0.0, 0.0]\naxis = [0, 0, -1]\n")
+    assert main(["run", str(p), "-o", str(tmp_path / "o.nc"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "needs the motor on the body axis" in err and len(err.splitlines()) == 1
+    assert "0.05 m off it" in err

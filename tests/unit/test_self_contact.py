@@ -113,3 +113,20 @@ def test_kernel_skips_contour_neighbours():
     E, dmin = self_contact_energy_grad(x, sc.cut, sc.sigma, sc.eps, sc.c2, sc.first(len(x) - 1), g,
                                      sc.skip(len(x) - 1))
     assert E == 0.0 and not g.any() and dmin >= 0.02 * (sc.exclude) - 1e-12
+
+
+def test_crossing_counter_over_two_filaments_counts_their_pass_through_not_the_join():
+    # filament A: beads 0-1 along x; filament B: beads 2-3 along y, passing down through A.
+    # As one chain, segment 1 (the join 1-2) would be a segment; as two filaments it is not,
+    # and the pass-through of B's only segment through A's is counted once
+    frames = []
+    for z in np.linspace(0.05, -0.05, 11):
+        frames.append([[-0.5, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, -0.5, z], [0.0, 0.5, z]])
+    X = np.array(frames)
+    assert count_crossings(X, exclude=1, near=0.2, chains=[2, 2]) == 1
+    # the neighbour exclusion holds within a filament only: with exclude = 5 the pair is
+    # still counted (different filaments), where one chain of 4 beads would skip it
+    assert count_crossings(X, exclude=5, near=0.2, chains=[2, 2]) == 1
+    assert count_crossings(X, exclude=5, near=0.2) == 0
+    with pytest.raises(ValueError, match="do not add up"):
+        count_crossings(X, chains=[2, 3])

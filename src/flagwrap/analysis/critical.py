@@ -174,10 +174,14 @@ def buckled_long_enough(traj, waiting, stop_after: float) -> str:
     from flagwrap.analysis.buckling import WaitingTime
     from flagwrap.simulation import TWO_PI
 
+    from flagwrap.observables.tip import free_end_heights
+
     turns = np.asarray(traj.t) / TWO_PI
-    x = np.asarray(traj.x)
-    w = WaitingTime(**waiting.params()).compute(turns, x[:, -1, 2] - x[:, 0, 2],
-                                                np.asarray(traj.omega))
+    heights = free_end_heights(np.asarray(traj.x), 1.0, max(1, len(traj.config.flagella)))
+    runs = [WaitingTime(**waiting.params()).compute(turns, h, np.asarray(traj.omega))
+            for h in heights.T]  # each flagellum; the first to buckle decides
+    buckled = [w for w in runs if w.buckled]
+    w = min(buckled, key=lambda r: r.crossing_turns) if buckled else runs[0]
     if w.buckled and turns[-1] - w.crossing_turns >= stop_after:
         return (f"stopped early at t/T = {turns[-1]:.3f}: buckled (crossing at "
                 f"{w.crossing_turns:.3f}), {stop_after:g} turns later")

@@ -34,9 +34,12 @@ VARIABLES = ("free_end_height", "free_end_height_smoothed", "winding_turns", "co
              "perversion_bead")
 
 
-def analyze_dataset(ds, analysis: BucklingAnalysis | None = None) -> BucklingAnalysis:
-    """Run :class:`BucklingAnalysis` on a run dataset (:func:`flagwrap.io.runfile.read_run`)."""
-    from flagwrap.io.runfile import config_of
+def analyze_dataset(ds, analysis: BucklingAnalysis | None = None,
+                    filament: int = 0) -> BucklingAnalysis:
+    """Run :class:`BucklingAnalysis` on a run dataset (:func:`flagwrap.io.runfile.read_run`),
+    on its flagellum ``filament`` (a run of several: :func:`~flagwrap.io.runfile.
+    filament_slices`). The motor torque is the run's (all motors' sum)."""
+    from flagwrap.io.runfile import config_of, filament_slices
 
     need = ("position", "turns", "omega")
     missing = [v for v in need if v not in ds.variables]
@@ -55,6 +58,7 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None) -> BucklingAna
         from flagwrap.observables.swimming import body_frame
 
         x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
+    x = x[:, filament_slices(ds)[filament]]
     return a.compute(ds["turns"].values, x, ds["omega"].values,
                      float(ds.attrs["length"]), cfg.body.resolved_radius(R),
                      cfg.body.resolved_length(R), tq, body_shape=cfg.body.shape)
@@ -76,27 +80,64 @@ def joint_summary(ds) -> dict:
     return out
 
 
-def annotate(ds, analysis: BucklingAnalysis):
-    """Return a copy of ``ds`` with the results of a computed ``analysis`` stored in it."""
-    out = ds.drop_vars([v for v in VARIABLES if v in ds.variables])
+def annotate(ds, analysis, bundle: dict | None = None):
+    """Return a copy of ``ds`` with the results of a computed ``analysis`` stored in it; a
+    run of several flagella: ``analysis`` one per flagellum (the series get a ``filament``
+    dimension, the attributes are the first to buckle's, :func:`combined_summary`, with every
+    flagellum's in ``analysis_filaments`` as JSON) and ``bundle`` (:func:`flagwrap.
+    observables.bundle.bundle_summary`)."""
+    many = isinstance(analysis, (list, tuple))
+    each = list(analysis) if many else [analysis]
+    out = ds.drop_vars([v for v in VARIABLES + ("bundle_separation", "bundle_phase_lag")
+                        if v in ds.variables])
     out.attrs = {k: v for k, v in ds.attrs.items() if not k.startswith(PREFIX)}
-    for k, v in {**analysis.summary(), **joint_summary(ds)}.items():
+    summary = combined_summary(each) if many else each[0].summary()
+    for k, v in {**summary, **joint_summary(ds)}.items():
         if isinstance(v, bool):
             v = int(v)
         out.attrs[PREFIX + k] = v
-    out.attrs[PREFIX + "params"] = json.dumps(analysis.params(), sort_keys=True)
+    out.attrs[PREFIX + "params"] = json.dumps(each[0].params(), sort_keys=True)
+    if many:
+        from flagwrap.sweep.store import jsonable as _jsonable
+
+        out.attrs[PREFIX + "filaments"] = json.dumps(_jsonable([a.summary() for a in each]))
     from flagwrap import __version__
 
     out.attrs[PREFIX + "version"] = __version__
-    w, f = analysis.waiting, analysis.final
-    out["free_end_height"] = ("time", analysis.height, {"units": "1", "long_name": "(z(L)-z(0))/L"})
-    out["free_end_height_smoothed"] = ("time", w.smoothed, {"units": "1"})
-    out["winding_turns"] = ("time", f.winding_series,
+    dims = ("filament", "time") if many else ("time",)
+
+    def series(get):
+        v = [np.asarray(get(a)) for a in each]
+        return np.stack(v) if many else v[0]
+
+    out["free_end_height"] = (dims, series(lambda a: a.height),
+                              {"units": "1", "long_name": "(z(L)-z(0))/L"})
+    out["free_end_height_smoothed"] = (dims, series(lambda a: a.waiting.smoothed), {"units": "1"})
+    out["winding_turns"] = (dims, series(lambda a: a.final.winding_series),
                             {"units": "1", "long_name": "|winding| of beads beside the body [turns]"})
-    out["contact_fraction"] = ("time", f.contact_series, {"units": "1"})
-    out["perversion_bead"] = ("time", analysis.perversion_bead.astype(np.int32),
+    out["contact_fraction"] = (dims, series(lambda a: a.final.contact_series), {"units": "1"})
+    out["perversion_bead"] = (dims, series(lambda a: a.perversion_bead.astype(np.int32)),
                               {"units": "1", "long_name": "perversion bead nearest the clamp (-1 none)"})
+    if bundle is not None:
+        out["bundle_separation"] = ("time", bundle["separation_series"],
+                                    {"units": "1", "long_name": "distal centroid separation / R"})
+        out["bundle_phase_lag"] = (("time", "filament"), bundle["phase_lag_series"],
+                                   {"units": "rad", "long_name": "free-end phase minus flagellum 0's"})
+        for k in ("separation", "bundled", "crossings"):
+            if k in bundle:
+                out.attrs[PREFIX + "bundle_" + k] = (int(bundle[k]) if k != "separation"
+                                                     else bundle[k])
     return out
+
+
+def combined_summary(analyses) -> dict:
+    """A run of several flagella as one verdict: the summary of the first flagellum to buckle
+    (earliest threshold crossing; flagellum 0 if none does), with ``filament`` its index and
+    ``n_buckled`` how many buckled. Critical-M searches and sweeps read this."""
+    sums = [a.summary() for a in analyses]
+    buckled = [k for k, s in enumerate(sums) if s["buckled"]]
+    first = min(buckled, key=lambda k: sums[k]["crossing_turns"]) if buckled else 0
+    return {**sums[first], "filament": first, "n_buckled": len(buckled)}
 
 
 def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool = True) -> dict:
@@ -114,18 +155,56 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
     """
     from flagwrap.io.runfile import read_run, write_dataset_atomic
 
+    from flagwrap.io.runfile import filament_slices
+
     path = Path(path)
     ds = read_run(path)
-    a = analyze_dataset(ds, analysis)
-    if write:
-        write_dataset_atomic(annotate(ds, a), path)
-    res = {**a.summary(), **joint_summary(ds)}
+    slices = filament_slices(ds)
+    if len(slices) == 1:
+        a = analyze_dataset(ds, analysis)
+        if write:
+            write_dataset_atomic(annotate(ds, a), path)
+        res = {**a.summary(), **joint_summary(ds)}
+    else:
+        res = _analyze_flagella(ds, analysis, slices, path, write)
+        a = res.pop("_first")
     from flagwrap.observables.swimming import swimming_summary
 
     res["swimming"] = swimming_summary(ds, final_turns=a.final.final_turns)
     res["params"] = a.params()
     res["path"] = str(path)
     res["run_status"] = str(ds.attrs.get("status", ""))
+    return res
+
+
+def _analyze_flagella(ds, analysis, slices, path, write: bool) -> dict:
+    """Every flagellum of a run of several, and the bundle they make (module docstring of
+    :mod:`flagwrap.observables.bundle`)."""
+    import copy
+
+    from flagwrap.io.runfile import config_of, write_dataset_atomic
+    from flagwrap.observables.bundle import bundle_summary
+
+    base = analysis if analysis is not None else BucklingAnalysis()
+    each = [analyze_dataset(ds, copy.deepcopy(base), k) for k in range(len(slices))]
+    x = ds["position"].values
+    if "body_position" in ds.variables:
+        from flagwrap.observables.swimming import body_frame
+
+        x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
+    cfg = config_of(ds)
+    bundle = bundle_summary(ds["turns"].values, x, slices, cfg.filament.helix_radius,
+                            final_turns=base.final.final_turns)
+    from flagwrap.interactions.self_contact import count_crossings
+
+    # segments passing through each other between saved frames, within and between flagella
+    bundle["crossings"] = count_crossings(x, chains=[s.stop - s.start for s in slices])
+    if write:
+        write_dataset_atomic(annotate(ds, each, bundle), path)
+    res = {**combined_summary(each), **joint_summary(ds)}
+    res["filaments"] = [a.summary() for a in each]
+    res["bundle"] = {k: v for k, v in bundle.items() if not k.endswith("_series")}
+    res["_first"] = each[res["filament"]]
     return res
 
 

@@ -58,6 +58,7 @@ ROWS = [
 
 def run(args) -> int:
     import json
+    import math
 
     from flagwrap.analysis.buckling import BucklingAnalysis, FinalState, WaitingTime
     from flagwrap.analysis.runfile_attrs import analyze_run_file, jsonable
@@ -97,6 +98,21 @@ def run(args) -> int:
         for key, label, fmt in ROWS:
             v = res[key]
             print(f"  {label:<30s} {fmt.format(v) if not (isinstance(v, float) and v != v) else '-'}")
+        if "filaments" in res:  # several flagella: each, and the bundle they make
+            which = "the first to buckle" if res["n_buckled"] else "none buckled"
+            print(f"  (the rows above: flagellum {res['filament']}, {which}; "
+                  f"{res['n_buckled']} of {len(res['filaments'])} buckled)")
+            for k, f in enumerate(res["filaments"]):
+                tc = f["waiting_time_turns"]
+                print(f"  flagellum {k}: {f['state']}, buckled {f['buckled']}, t_c/T "
+                      f"{'-' if tc != tc else format(tc, '.3f')}, final height "
+                      f"{f['final_height']:+.4f}, winding {f['winding_turns']:.3f} turns")
+            b = res["bundle"]
+            lags = ", ".join(f"{math.degrees(v):+.0f}" for v in b["phase_lag"])
+            print(f"  bundle (final turns): separation {b['separation']:.3f} R "
+                  f"({'bundled' if b['bundled'] else 'not bundled'}: < 1 R), phase lags "
+                  f"to flagellum 0 [deg] {lags}; segments passed through each other: "
+                  f"{b['crossings']}")
         if res["buckled"] and not res["sustained"]:
             rise = res["final_height"] - res["baseline_height"]
             print(f"  note: the rise did not last: over the final {args.final_turns:g} turn(s) the "

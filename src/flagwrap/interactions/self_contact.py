@@ -379,14 +379,18 @@ def _oriented(p0, p1, q0, q1):
 
 
 @nb.njit(cache=True)
-def _crossings(X, exclude, near):
+def _crossings(X, exclude, near, chain):
     n = X.shape[1] - 1
     count = 0
     for k in range(X.shape[0] - 1):
         A = X[k]
         B = X[k + 1]
         for i in range(n):
-            for j in range(i + exclude + 1, n):
+            if chain[i] < 0:
+                continue
+            for j in range(i + 1, n):
+                if chain[j] < 0 or (chain[j] == chain[i] and j <= i + exclude):
+                    continue
                 va = _oriented(A[i], A[i + 1], A[j], A[j + 1])
                 vb = _oriented(B[i], B[i + 1], B[j], B[j + 1])
                 if (va > 0.0) == (vb > 0.0):  # no sign change (an exact 0 counts as negative)
@@ -402,13 +406,30 @@ def _crossings(X, exclude, near):
     return count
 
 
-def count_crossings(positions: np.ndarray, exclude: int = 2, near: float | None = None) -> int:
+def count_crossings(positions: np.ndarray, exclude: int = 2, near: float | None = None,
+                    chains=None) -> int:
     """Number of times two non-neighbouring segments pass through each other between
     consecutive frames of ``positions`` (F, N, 3): the oriented volume of the two segments
     changes sign while both are within ``near`` (default: one mean bond length) with their
     closest points inside both segments. Frames must be close enough that a segment moves
-    less than ``near`` between them (a run's saved frames are: 0.05 turns)."""
+    less than ``near`` between them (a run's saved frames are: 0.05 turns).
+
+    ``chains``: the bead counts of several filaments laid one after the other (a run of
+    several flagella); every pair of segments on different filaments counts, the joins
+    between them are no segments."""
     X = np.ascontiguousarray(positions, float)
+    n = X.shape[1] - 1
+    chain = np.zeros(n, np.int64)
+    if chains is not None:
+        if sum(chains) != X.shape[1]:
+            raise ValueError(f"chains {list(chains)} do not add up to {X.shape[1]} beads")
+        start = 0
+        for c, m in enumerate(chains):
+            chain[start:start + m - 1] = c
+            if start + m - 1 < n:
+                chain[start + m - 1] = -1  # the join to the next filament
+            start += m
     if near is None:
-        near = float(np.linalg.norm(np.diff(X[0], axis=0), axis=1).mean())
-    return int(_crossings(X, int(exclude), float(near)))
+        d = np.linalg.norm(np.diff(X[0], axis=0), axis=1)
+        near = float(d[chain >= 0].mean())
+    return int(_crossings(X, int(exclude), float(near), chain))

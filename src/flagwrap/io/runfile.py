@@ -121,6 +121,16 @@ def trajectory_dataset(traj):
                            "rotation sign: positive = CCW seen from the free end",
         },
     )
+    nf = max(1, len(cfg.flagella))
+    if nf > 1:  # several flagella: bead offsets (every flagellum is a copy of [filament])
+        n = x_si.shape[1] // nf
+        first = np.arange(nf) * n
+        ds["filament_first_bead"] = ("filament", first, {"units": "1",
+                                                         "long_name": "first bead of flagellum k"})
+        ds["filament_n_beads"] = ("filament", np.full(nf, n), {"units": "1"})
+        ds["tip_positions"] = (("time", "filament", "xyz"), x_si[:, first + n - 1, :],
+                               {"units": "m", "long_name": "free end of flagellum k"})
+        ds.attrs["n_flagella"] = nf
     if "body" in a:  # a free body's pose and velocities (core -> SI)
         b = a["body"]
         ds["body_position"] = (("time", "xyz"), b[:, :3] * L, {"units": "m"})
@@ -174,6 +184,15 @@ def read_run(path):
             f"({FORMAT_VERSION}); upgrade flagwrap"
         )
     return ds
+
+
+def filament_slices(ds) -> list:
+    """Each flagellum's beads in ``position``'s bead dimension (one slice for a run of one)."""
+    if "filament_first_bead" not in ds.variables:
+        return [slice(0, ds.sizes["bead"])]
+    first = ds["filament_first_bead"].values
+    n = ds["filament_n_beads"].values
+    return [slice(int(f), int(f + m)) for f, m in zip(first, n)]
 
 
 def config_of(ds):

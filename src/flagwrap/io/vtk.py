@@ -138,17 +138,17 @@ class ElasticForces:
         self.force_scale = config.scales.force
         self.energy_scale = config.scales.energy
 
-    def rest_twist(self) -> np.ndarray:
-        """Rest twist ``m_i^0`` [rad] per bead (N,)."""
-        return np.asarray(self.system.rest.mbar, float)
+    def rest_twist(self, filament: int = 0) -> np.ndarray:
+        """Rest twist ``m_i^0`` [rad] per bead (N,) of flagellum ``filament``."""
+        return np.asarray(self.system.parts[filament].rest.mbar, float)
 
-    def __call__(self, x: np.ndarray, m1: np.ndarray):
-        """Elastic energy [J] and forces ``-dE/dx`` (N, 3) [N] of one frame.
+    def __call__(self, x: np.ndarray, m1: np.ndarray, filament: int = 0):
+        """Elastic energy [J] and forces ``-dE/dx`` (N, 3) [N] of one frame of one flagellum.
 
         Parameters
         ----------
-        x : (N, 3) bead positions [m]
-        m1 : (N-1, 3) material directors
+        x : (N, 3) bead positions [m] of flagellum ``filament``
+        m1 : (N-1, 3) its material directors
         """
         from flagwrap.elasticity.rod import Frames, elastic_forces
         from flagwrap.geometry.frames import space_parallel_frames
@@ -159,7 +159,7 @@ class ElasticForces:
         theta = np.arctan2(np.einsum("ij,ij->i", m1, d2), np.einsum("ij,ij->i", m1, d1))
         theta = np.unwrap(theta)  # adjacent differences in (-pi, pi]
         base = Frames(t, d1, np.zeros(len(xc)))
-        E, f, _, _ = elastic_forces(xc, theta, base, self.system.rest)
+        E, f, _, _ = elastic_forces(xc, theta, base, self.system.parts[filament].rest)
         return E * self.energy_scale, f * self.force_scale
 
 
@@ -237,7 +237,20 @@ def pvd_xml(entries) -> str:
             f"  <Collection>\n{rows}  </Collection>\n</VTKFile>\n")
 
 
-def frame_point_data(x: np.ndarray, m1: np.ndarray, forces: ElasticForces | None = None,
+def frames_point_data(x, m1, slices, forces: ElasticForces | None = None,
+                      rest_twists=None) -> dict:
+    """:func:`frame_point_data` of every flagellum (bead ``slices``; their bonds follow one
+    another likewise, one fewer per flagellum), concatenated in bead order."""
+    parts = []
+    for k, sl in enumerate(slices):
+        bonds = slice(sl.start - k, sl.stop - k - 1)
+        parts.append(frame_point_data(
+            x[sl], m1[bonds], None if forces is None else (lambda xx, mm, k=k: forces(xx, mm, k)),
+            None if rest_twists is None else rest_twists[k]))
+    return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
+
+
+def frame_point_data(x: np.ndarray, m1: np.ndarray, forces=None,
                      rest_twist: np.ndarray | None = None) -> dict:
     """The per-bead fields of one frame (see the module docstring); ``x`` in [m]."""
     vor = voronoi_lengths(x)
@@ -272,7 +285,7 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
     n_around : azimuthal resolution of the body surface
     """
     from flagwrap.errors import UserInputError
-    from flagwrap.io.runfile import config_of
+    from flagwrap.io.runfile import config_of, filament_slices
     from flagwrap.plotting.render import body_poses, body_surface, scene_of
 
     if time_unit not in ("turns", "seconds"):
@@ -287,15 +300,16 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
     secs = ds["time"].values
     tvals = turns if time_unit == "turns" else secs
     elastic = ElasticForces(config_of(ds))  # the rest twist is needed either way
-    rest = elastic.rest_twist()
+    slices = filament_slices(ds)
+    rest = [elastic.rest_twist(k) for k in range(len(slices))]
     forces = elastic if with_forces else None
     entries = []
     idx = range(0, len(turns), stride)
     width = max(4, len(str(len(turns) - 1)))
-    line = [np.arange(X.shape[1])]
+    line = [np.arange(sl.start, sl.stop) for sl in slices]  # one polyline per flagellum
     for i in idx:
         name = f"filament_{i:0{width}d}.vtp"
-        pdata = frame_point_data(X[i], M1[i], forces, rest)
+        pdata = frames_point_data(X[i], M1[i], slices, forces, rest)
         cdata = {"turns": np.array([turns[i]]), "time": np.array([secs[i]])}
         _write(d / name, polydata_xml(X[i], lines=line, point_data=pdata, cell_data=cdata))
         entries.append((float(tvals[i]), 0, name))

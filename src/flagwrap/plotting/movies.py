@@ -160,21 +160,28 @@ class MovieFrames:
             style_view(ax, self.ulim, self.zlim, title=cam.name, scale_bar=bar if k == 0 else None)
         turns = ds["turns"].values
         L = ds.attrs["length"]
-        zt = (self.X[:, -1, 2] - self.X[:, 0, 2]) / L
+        from flagwrap.io.runfile import filament_slices
+        from flagwrap.observables.tip import free_end_heights
+
+        zt = free_end_heights(self.X, L, len(filament_slices(ds)))  # (T, flagella)
         tq = ds["motor_torque_reduced"].values
         self.ax_z = fig.add_axes((0.72, 0.52, 0.26, 0.24))
         self.ax_t = fig.add_axes((0.72, 0.12, 0.26, 0.24), sharex=self.ax_z)
         self._cursor = []
         self._dots = []
         self._series = []
-        for ax, y, col, lab in ((self.ax_z, zt, "C0", r"$[z(L)-z(0)]/L$"),
-                                (self.ax_t, tq, "C3", r"$N_m R/A$")):
-            ax.plot(turns, y, color=col, lw=0.6, alpha=0.3)
-            (live,) = ax.plot([], [], color=col, lw=1.2)
-            (dot,) = ax.plot([], [], "o", color=col, ms=4)
+        many = zt.shape[1] > 1  # one height line per flagellum, in its tube's colour
+        for ax, ys, cols, lab in (
+                (self.ax_z, zt.T, [f"C{k}" if many else "C0" for k in range(zt.shape[1])],
+                 r"$[z(L)-z(0)]/L$"),
+                (self.ax_t, [tq], ["C3"], r"$N_m R/A$" + (" (all)" if many else ""))):
+            for y, col in zip(ys, cols):
+                ax.plot(turns, y, color=col, lw=0.6, alpha=0.3)
+                (live,) = ax.plot([], [], color=col, lw=1.2)
+                (dot,) = ax.plot([], [], "o", color=col, ms=4)
+                self._series.append((live, y))
+                self._dots.append(dot)
             self._cursor.append(ax.axvline(turns[0], color="0.4", lw=0.6))
-            self._series.append((live, y))
-            self._dots.append(dot)
             ax.set_ylabel(lab, fontsize=8)
             ax.tick_params(labelsize=7)
             ax.axhline(0, color="0.7", lw=0.5, ls="--")
@@ -220,8 +227,9 @@ class MovieFrames:
             self._motor.set_text("motor: stopped")
             self._motor.set_color("0.3")
         ts = self._turns_saved
-        for cur, (live, y), dot in zip(self._cursor, self._series, self._dots):
+        for cur in self._cursor:
             cur.set_xdata([turn, turn])
+        for (live, y), dot in zip(self._series, self._dots):
             upto = ts <= turn
             yi = float(np.interp(turn, ts, y))
             live.set_data(np.append(ts[upto], turn), np.append(y[upto], yi))

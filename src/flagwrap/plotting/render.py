@@ -82,6 +82,9 @@ class Scene:
         ``R_cell`` and the cylinder length ``H`` [m]; ``body_radius = 0`` means no body.
     length : float
         Filament contour length ``L`` [m] (sets the default framing).
+    filaments : tuple of (start, stop)
+        Each flagellum's beads in ``x`` (empty: one filament, all the beads); every one is
+        drawn as its own tube.
     """
 
     tube_radius: float
@@ -89,6 +92,11 @@ class Scene:
     body_length: float
     length: float
     body_shape: str = "capped-cylinder"
+    filaments: tuple = ()
+
+    def chains(self, n_beads: int) -> list:
+        """The bead slices of the tubes to draw for ``n_beads`` beads."""
+        return [slice(a, b) for a, b in self.filaments] or [slice(0, n_beads)]
 
     @property
     def has_body(self) -> bool:
@@ -105,8 +113,12 @@ def scene_of(ds) -> Scene:
         Rc, H = cfg.body.resolved_radius(R), cfg.body.resolved_length(R)
     else:
         Rc, H = 0.0, 0.0
+    from flagwrap.io.runfile import filament_slices
+
+    sl = filament_slices(ds)
     return Scene(float(cfg.filament.cross_section_radius), float(Rc), float(H),
-                 float(ds.attrs["length"]), cfg.body.shape)
+                 float(ds.attrs["length"]), cfg.body.shape,
+                 tuple((s.start, s.stop) for s in sl) if len(sl) > 1 else ())
 
 
 def body_poses(ds):
@@ -286,6 +298,9 @@ def _face_normals(poly: np.ndarray) -> np.ndarray:
 # drawing
 
 TUBE_RGB = np.array([0.20, 0.40, 0.75])
+#: the tubes of several flagella (the first is the single filament's colour)
+TUBE_PALETTE = (TUBE_RGB, np.array([0.80, 0.35, 0.15]), np.array([0.20, 0.60, 0.30]),
+                np.array([0.55, 0.30, 0.65]), np.array([0.75, 0.60, 0.10]))
 BODY_RGB = np.array([0.62, 0.64, 0.66])
 BODY_ALPHA = 0.4
 
@@ -346,11 +361,15 @@ class Renderer:
         polys : list of (k, 2) arrays [m] in image coordinates, back to front
         rgba : (P, 4) face colours
         """
-        quads, qn, caps, cn = tube_faces(x, self.scene.tube_radius, self.sides, self.subdivide)
         toward = np.asarray(camera.toward)
         groups = []  # (polys3d list-like, normals, rgb, alpha)
-        groups.append((quads, qn, self.tube_rgb, 1.0))
-        groups.append((caps, cn, self.tube_rgb, 1.0))
+        chains = self.scene.chains(len(x))
+        for k, sl in enumerate(chains):  # one tube per flagellum, each its own colour
+            quads, qn, caps, cn = tube_faces(x[sl], self.scene.tube_radius, self.sides,
+                                             self.subdivide)
+            rgb = self.tube_rgb if len(chains) == 1 else TUBE_PALETTE[k % len(TUBE_PALETTE)]
+            groups.append((quads, qn, rgb, 1.0))
+            groups.append((caps, cn, rgb, 1.0))
         if len(self._body):
             body, bn = self._body, self._body_n
             if pose is not None:

@@ -23,14 +23,22 @@ def summary_figure(ds, path):
 
     turns = ds["turns"].values
     L = ds.attrs["length"]
-    z = (ds["position"].values[:, -1, 2] - ds["position"].values[:, 0, 2]) / L
+    from flagwrap.io.runfile import filament_slices
+    from flagwrap.observables.tip import free_end_heights
+
+    many = len(filament_slices(ds)) > 1
+    z = free_end_heights(ds["position"].values, L, len(filament_slices(ds)))
     tq = ds["motor_torque_reduced"].values
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
-    a1.plot(turns, z, color="C0")
+    for k in range(z.shape[1]):  # one line per flagellum
+        a1.plot(turns, z[:, k], color=f"C{k}" if many else "C0",
+                label=f"flagellum {k}" if many else None)
+    if many:
+        a1.legend(fontsize=7)
     a1.axhline(0, color="0.6", lw=0.8, ls="--")
     a1.set_ylabel(r"$[z(L)-z(0)]/L$")
     a2.plot(turns, tq, color="C3")
-    a2.set_ylabel(r"$N_m R/A$ (CCW > 0)")
+    a2.set_ylabel(r"$N_m R/A$ (CCW > 0)" + (", all motors" if many else ""))
     a2.set_xlabel(r"$t/T$")
     for t_sw in _switch_turns(ds):
         for ax in (a1, a2):

@@ -278,11 +278,22 @@ def check_flagella(config) -> None:
             if not float(n @ np.asarray(f.axis, float)) > 0.0:
                 raise UserInputError(f"{where}.axis = {list(f.axis)} points into the body; the "
                                      "motor axis must point out of it")
+    if len(config.flagella) > 1 and config.motor.kind != "speed":
+        raise UserInputError(f"motor.kind = {config.motor.kind!r}: several flagella run on speed "
+                             "motors only for now (motor.kind = \"speed\")")
     if len(config.flagella) > 1 and config.numerics.frame != "lab":
         raise UserInputError(f"numerics.frame = {config.numerics.frame!r} needs one flagellum on "
                              f"the motor axis; this config has {len(config.flagella)} "
                              "[[flagellum]] tables: use numerics.frame = 'lab'")
     places = placements_from_config(config)
+    if config.numerics.frame != "lab":  # one flagellum: its motor must turn about the body axis
+        o, ax = np.asarray(places[0].origin, float), places[0].axis
+        if math.hypot(o[0], o[1]) > 1e-12 or math.hypot(ax[0], ax[1]) > 1e-12:
+            raise UserInputError(
+                f"numerics.frame = {config.numerics.frame!r} needs the motor on the body axis; "
+                f"flagellum[0] sits {math.hypot(o[0], o[1]) * L:.3g} m off it with its axis "
+                f"{math.degrees(math.acos(min(1.0, abs(ax[2])))):.3g} deg from it: use "
+                "numerics.frame = 'lab'")
     shape = filament_positions(fil, config.clamp) / L
     shapes = [pl.apply(shape) for pl in places]
     for k in range(len(shapes)):

@@ -89,13 +89,16 @@ class RodSystem:
     ec = _one_filament("ec")
 
     def __init__(self, config, x0=None, theta0=None, body=None, clamp=None, mobility=None,
-                 joint=None, interactions=(), placements=None):
+                 joint=None, interactions=(), placements=None, drive=None):
         """``joint`` (or its old name ``clamp``): a built joint for the shape ``x0`` (default:
         :func:`flagwrap.joints.make_joint` from ``config.joint``); ``interactions``: extra
         energy terms (:mod:`flagwrap.interactions.base`) after those the config asks for;
         ``placements``: one :class:`~flagwrap.system.parts.Placement` per filament (default:
         the config's ``[[flagellum]]`` tables, or one filament at the origin), each a copy of the config's filament and joint on its
-        own speed motor (the motors turn together, by ``config.motor``'s protocol)."""
+        own speed motor (the motors turn together, by ``config.motor``'s protocol);
+        ``drive``: a motor law object (:mod:`flagwrap.motor.drive`'s interface; default
+        :func:`~flagwrap.motor.drive.make_drive` from ``config.motor``), one filament only
+        when its angle is free (``drive.free``)."""
         self.config = config
         fil = config.filament
         L = fil.length
@@ -130,6 +133,8 @@ class RodSystem:
                 gravity_number=config.gravity_number if fil.density is not None else None,
                 name=f"flagellum{k}"))
         self.parts = parts
+        # the motor law: its angle is an unknown (layout kind "angle") when the law is free
+        self.drive = drive or make_drive(config, zeta=self.machin * parts[0].rot_drag[0])
         self._assemble(config)
         num = config.numerics
         self.mobility = mobility or body_mobility(config, self.radius) or make_mobility(
@@ -151,12 +156,11 @@ class RodSystem:
             self.body = body or NoBody()
         self._has_body = not isinstance(self.body, NoBody)
         self.schedule = Schedule(config.motor.protocol)
-        self.drive = make_drive(config, zeta=self.machin * self.rot_drag[0])
         if len(parts) > 1 and self.drive.free:
             from flagwrap.errors import UserInputError
 
             raise UserInputError(
-                f"motor.kind = {config.motor.kind!r}: several flagella run on speed motors "
+                f"motor.kind = {self.drive.kind!r}: several flagella run on speed motors "
                 "only for now (motor.kind = \"speed\")")
         self.interactions = self._config_interactions() + list(interactions)
 
@@ -170,7 +174,7 @@ class RodSystem:
         self.N = sum(p.N for p in parts)
         self.nb = sum(p.nb for p in parts)  # free beads
         self.ne = sum(p.ne for p in parts)  # free bonds
-        motor = "prescribed" if config.motor.kind == "speed" else "angle"
+        motor = "angle" if self.drive.free else "prescribed"
         self.layout = DofLayout.clamped_filament(self.nb, self.ne, motor, n_motors=len(parts))
         self.ny = self.layout.size
         self.sl_x = self.layout["x"]

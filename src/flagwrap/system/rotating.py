@@ -32,6 +32,8 @@ scales as ``1/M`` for translation and twist alike, so one system built at ``M_0`
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from flagwrap.errors import UserInputError
@@ -76,6 +78,11 @@ def check_rotating_frame(system, blob_body: bool = False) -> None:
     if np.linalg.norm(np.cross(a, ez)) > 1e-12:
         # the capped cylinder and gravity are along z: the motor axis must be too
         raise UserInputError("the rotating frame needs the motor axis along the body axis z")
+    o = np.asarray(getattr(joint, "origin", np.zeros(3)), float)
+    if math.hypot(o[0], o[1]) > 1e-12:
+        raise UserInputError(
+            "the rotating frame needs the motor on the body axis; this flagellum's anchor is "
+            f"{math.hypot(o[0], o[1]):.3g} L off it ([[flagellum]] anchor)")
     g = np.asarray(system.gravity)
     if np.any(np.abs(g[:, :2]) > 0.0):
         raise UserInputError("the rotating frame needs gravity along the motor axis")
