@@ -187,9 +187,13 @@ def read_run(path):
 
 
 def filament_slices(ds) -> list:
-    """Each flagellum's beads in ``position``'s bead dimension (one slice for a run of one)."""
+    """Each flagellum's beads in ``position``'s bead dimension (one slice for a run of one).
+    A file without the offsets takes them from its config's ``[[flagellum]]`` tables (every
+    flagellum a copy of one filament)."""
     if "filament_first_bead" not in ds.variables:
-        return [slice(0, ds.sizes["bead"])]
+        nf = max(1, len(config_of(ds).flagella)) if "config_toml" in ds.attrs else 1
+        n = ds.sizes["bead"] // nf
+        return [slice(k * n, (k + 1) * n) for k in range(nf)]
     first = ds["filament_first_bead"].values
     n = ds["filament_n_beads"].values
     return [slice(int(f), int(f + m)) for f, m in zip(first, n)]
