@@ -123,3 +123,28 @@ def test_renderer_draws_every_flagellum(two_run):
     polys_one, _ = one.polygons(x, CAMERAS[0])
     # as two tubes, no tube joins the first flagellum's free end to the second one's anchor
     assert len(polys_two) != len(polys_one)
+
+
+def test_analyze_and_its_figure_on_a_free_cell_with_two_flagella(tmp_path, capsys):
+    # the free swimmer kind: the analysis in the body's frame, per flagellum, and the
+    # swimming figure with one height line per flagellum
+    import json
+    import tomllib
+
+    from flagwrap.cli.main import main
+    from flagwrap.io.config import config_from_dict
+    from flagwrap.io.runfile import write_run
+    from flagwrap.simulation import simulate
+    from test_parts import TWO
+
+    text = TWO + ("[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n"
+                  "[[flagellum]]\npolar_deg = 35\n[[flagellum]]\npolar_deg = 35\n"
+                  "azimuth_deg = 180\n")
+    tr = simulate(config_from_dict(tomllib.loads(text)))
+    assert tr.ok and tr.body
+    path = write_run(tr, tmp_path / "free2.nc")
+    png = tmp_path / "swim.png"
+    assert main(["analyze", str(path), "--json", "--figure", str(png)]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert len(res["filaments"]) == 2 and "separation" in res["bundle"]
+    assert png.is_file() and png.stat().st_size > 10_000

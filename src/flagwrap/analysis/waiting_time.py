@@ -167,11 +167,15 @@ def departure_time(ds, rise: float = 0.05) -> float:
         a run (:func:`flagwrap.io.runfile.read_run`).
     """
     from flagwrap.analysis.buckling import WaitingTime
+    from flagwrap.io.runfile import filament_slices
+    from flagwrap.observables.tip import free_end_heights
 
-    x = ds["position"].values
-    h = (x[:, -1, 2] - x[:, 0, 2]) / float(ds.attrs["length"])
+    h = free_end_heights(ds["position"].values, float(ds.attrs["length"]),
+                         len(filament_slices(ds)))
     w = WaitingTime(threshold=rise, hold_turns=0.0, onset="crossing")
-    return float(w.compute(ds["turns"].values, h, ds["omega"].values).waiting_time)
+    times = np.array([w.compute(ds["turns"].values, hk, ds["omega"].values).waiting_time
+                      for hk in h.T])  # several flagella: the first to depart
+    return float(times[np.isfinite(times)].min()) if np.isfinite(times).any() else float("nan")
 
 
 def default_cw_turns(eps: float, c: float = 0.5, minimum: float = 10.0, margin: float = 5.0) -> float:

@@ -25,7 +25,7 @@ from flagwrap.observables.handedness import (
     perversions,
     right_handed_fraction,
 )
-from flagwrap.observables.tip import free_end_height, tip_trajectory
+from flagwrap.observables.tip import free_end_height, free_end_heights, tip_trajectory
 from flagwrap.observables.torque import cw_torque_peak, plateau_value, reduced_torque, torque_peak
 from flagwrap.observables.winding import azimuth, winding_angle, winding_turns
 
@@ -34,6 +34,7 @@ __all__ = [
     "body_distance",
     "discrete_torsion",
     "free_end_height",
+    "free_end_heights",
     "local_handedness",
     "near_body_fraction",
     "near_body_mask",

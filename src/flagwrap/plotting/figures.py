@@ -144,8 +144,9 @@ def _after_switch(ds):
 
 
 def _height(ds):
-    x = ds["position"].values
-    return (x[:, -1, 2] - x[:, 0, 2]) / float(ds.attrs["length"])
+    from flagwrap.observables.tip import free_end_height
+
+    return free_end_height(ds["position"].values, float(ds.attrs["length"]))
 
 
 def plot_fig4(runs, path=None):
@@ -193,8 +194,9 @@ def plot_fig4(runs, path=None):
     key = (ratios[-1], True) if ratios and (ratios[-1], True) in runs else next(iter(runs), None)
     if key is not None:
         ds = runs[key]
-        x = ds["position"].values
-        tip = (x[:, -1] - x[:, 0]) / float(ds.attrs["length"])
+        from flagwrap.observables.tip import tip_trajectory
+
+        tip = tip_trajectory(ds["position"].values, float(ds.attrs["length"]))
         ts, i = _after_switch(ds)
         sel = slice(max(i - 1, 0), None)
         ae.plot(tip[:max(i, 1), 0], tip[:max(i, 1), 1], tip[:max(i, 1), 2], color="0.7", lw=0.6, label="CCW")

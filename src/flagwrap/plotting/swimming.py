@@ -15,8 +15,10 @@ import numpy as np
 def swimming_series(ds) -> dict:
     """Time series of a free swimmer's run dataset (SI): ``t``, ``displacement`` along the
     initial body axis, ``motor_hz`` and ``body_hz`` (rates between saved frames, at their
-    midpoints ``t_mid``), ``height`` of the free end in the body frame over L."""
+    midpoints ``t_mid``), ``height`` (T, flagella) of each free end in the body frame over L."""
+    from flagwrap.io.runfile import filament_slices
     from flagwrap.observables.swimming import body_frame, quaternion_matrices, turn_angles
+    from flagwrap.observables.tip import free_end_heights
 
     t = ds["time"].values
     X = ds["body_position"].values
@@ -30,7 +32,7 @@ def swimming_series(ds) -> dict:
     L = float(ds.attrs["length"])
     return dict(t=t, displacement=disp, t_mid=0.5 * (t[1:] + t[:-1]),
                 motor_hz=np.diff(phi) / dt / (2 * np.pi), body_hz=turn / dt / (2 * np.pi),
-                height=(xb[:, -1, 2] - xb[:, 0, 2]) / L)
+                height=free_end_heights(xb, L, len(filament_slices(ds))))
 
 
 def plot_swimming(ds, path):
@@ -53,7 +55,12 @@ def plot_swimming(ds, path):
     ax[1].axhline(0, color="0.7", lw=0.6)
     ax[1].set_ylabel("rate [Hz]")
     ax[1].legend(fontsize=7, frameon=False)
-    ax[2].plot(s["t"], s["height"], color="k")
+    many = s["height"].shape[1] > 1
+    for k, h in enumerate(s["height"].T):  # one line per flagellum
+        ax[2].plot(s["t"], h, color=f"C{k}" if many else "k",
+                   label=f"flagellum {k}" if many else None)
+    if many:
+        ax[2].legend(fontsize=7)
     ax[2].set_ylabel("free-end height\n(body frame) / L")
     ax[2].set_xlabel("t [s]")
     for a in ax:
