@@ -59,7 +59,7 @@ def memory_table(spacings=(0.038, 0.026, 0.018, 0.0127), solvers=("direct", "kry
     import tracemalloc
 
     from flagwrap.body.multiblob import inset_capped_cylinder_blobs
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
     from flagwrap.system.rod_system import RodSystem
 
     cfg = get_case("fig4a")

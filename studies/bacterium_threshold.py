@@ -40,7 +40,7 @@ def config(case: str, spacing: float):
 def turned_frame(cfg, omega: float):
     """The frame of ``cfg`` with its blob shell turned by half the widest ring's blob angle."""
     from flagwrap.body.multiblob import cell_body_blobs
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
     from flagwrap.system.rod_system import RodSystem
     from flagwrap.system.rotating import RotatingFrame, rotation
     from flagwrap.system.swimmer import SwimmerFrame, SwimmerSystem

@@ -70,7 +70,7 @@ def test_lagged_screening_recomputes_only_past_its_refresh_distance(body):
     # its distance to the nearest blob gets the old matrix (the same object), one that moves
     # farther a fresh one, equal to the exact screening there
     from flagwrap.body.solver import LaggedScreening
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
 
     b, r = body
     x = np.array([[0.0, 0.0, -0.05], [0.02, 0.0, -0.1], [0.0, 0.03, -0.2]])
@@ -94,7 +94,7 @@ def test_lagged_screening_recomputes_only_past_its_refresh_distance(body):
 def test_lagged_screening_stays_out_of_w_with_the_krylov_solver(body):
     # one screening would be a CG solve per bead coordinate: the Krylov path goes without
     from flagwrap.body.solver import LaggedScreening
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
 
     b, r = body
     x = np.array([[0.0, 0.0, -0.05], [0.02, 0.0, -0.1]])

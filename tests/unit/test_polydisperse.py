@@ -93,7 +93,7 @@ def test_fixed_sphere_screens_a_far_bead_by_its_first_reflection(d, tol):
     # i.e. -3R/(8 pi d^2) along the line and -3R/(32 pi d^2) across (method of reflections).
     # The next reflection is O((R/d)^2) relative: measured 1.06e-2, 2.6e-3, 7e-4 radial and
     # 2.1e-2, 5.3e-3, 1.3e-3 across at d/R = 10, 20, 40; tol about 1.5x that (across)
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
 
     b, ab, Rt = _sphere_body()
     mob = FixedBodyMobility(0.05, b, ab)
@@ -103,7 +103,7 @@ def test_fixed_sphere_screens_a_far_bead_by_its_first_reflection(d, tol):
 
 
 def test_fixed_body_mobility_is_the_schur_complement_and_positive_definite():
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
 
     b, ab, _ = _sphere_body(2)
     rng = np.random.default_rng(4)

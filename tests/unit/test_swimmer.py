@@ -216,7 +216,7 @@ def test_a_short_free_run_counter_rotates_and_records_the_body(tmp_path):
 
 def test_fixed_body_limit_of_a_huge_body_drag(swimmer, rng):
     # scaling the body's mobility N to zero (an immovable body) gives the fixed no-slip body
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
 
     s = swimmer
     y, info = perturbed_state(s, rng)
@@ -266,7 +266,7 @@ def test_body_overlapping_the_filament_is_refused():
 
 
 def test_swimmer_needs_the_direct_free_space_mobility():
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
     from flagwrap.system.rod_system import RodSystem
 
     cfg = swimmer_config()
@@ -346,7 +346,7 @@ def test_stiff_elastic_swimmer_moves_like_the_rigid_one():
 
 
 def test_fixed_no_slip_body_is_wired_and_keeps_the_paper_keys():
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
     from flagwrap.params import Numerics
     from flagwrap.simulation import make_system
 
@@ -413,7 +413,7 @@ def test_fixed_no_slip_stage_w_is_the_lagged_screened_matrix(monkeypatch):
     # order for any W, so the run with the exact W (stage_matrix removed) must end where this
     # one does, to the errors of two tol-controlled runs: 20 tol, under the 25 x tol the
     # shorter one's 25 steps can add up to
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
     from flagwrap.simulation import make_system, simulate
 
     cfg = swimmer_config(motion="fixed")

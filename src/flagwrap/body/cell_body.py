@@ -89,12 +89,12 @@ class NoBody:
 
 def body_mobility(config, radius: float):
     """The beads' mobility beside ``config``'s fixed no-slip body
-    (:class:`~flagwrap.hydrodynamics.polydisperse.FixedBodyMobility`, bead ``radius`` in core
+    (:class:`~flagwrap.body.fixed_mobility.FixedBodyMobility`, bead ``radius`` in core
     units), or ``None`` for a transparent body (the free-space mobility applies)."""
     if not config.body.no_slip:
         return None
     from flagwrap.body.multiblob import cell_body_blobs
-    from flagwrap.hydrodynamics.polydisperse import FixedBodyMobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
 
     blobs, radii = cell_body_blobs(config)
     return FixedBodyMobility(radius, blobs, radii, solver=config.body.solver)

@@ -1,6 +1,6 @@
 """Solves with a fixed blob body's RPY matrix ``M_bb`` (``[body] solver``).
 
-Every product of the no-slip body's mobilities (:class:`~flagwrap.hydrodynamics.polydisperse.
+Every product of the no-slip body's mobilities (:class:`~flagwrap.body.fixed_mobility.
 FixedBodyMobility`, :class:`~flagwrap.system.swimmer.SwimmerSystem`) needs ``M_bb^-1 r``.
 The blobs do not move in the body's frame, so ``M_bb`` is the same for a whole run.
 
@@ -22,6 +22,8 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.linalg.blas import dsymv as _symv
 
+from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, rpy_apply_radii
+
 #: most blobs for which "auto" takes the direct solver (a 1500-blob factor is 162 MB)
 AUTO_DIRECT_MAX = 1500
 KINDS = ("auto", "direct", "krylov")
@@ -41,8 +43,6 @@ class DirectBlobSolver:
 
     def __init__(self, blobs: np.ndarray, radii: np.ndarray):
         from scipy.linalg import lapack
-
-        from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY
 
         Mbb = PolydisperseRPY(radii).matrix(blobs)
         L, info = lapack.dpotrf(Mbb, lower=1, overwrite_a=1)
@@ -85,8 +85,6 @@ class KrylovBlobSolver:
                  block: int = 64, maxiter: int = 500):
         from scipy.spatial import cKDTree
 
-        from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY
-
         self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
         self.radii = np.ascontiguousarray(radii, dtype=np.float64)
         self.rtol, self.maxiter = float(rtol), int(maxiter)
@@ -104,8 +102,6 @@ class KrylovBlobSolver:
 
     def apply(self, v: np.ndarray) -> np.ndarray:
         """``M_bb v``, the RPY sum (no matrix)."""
-        from flagwrap.hydrodynamics.polydisperse import rpy_apply_radii
-
         out = np.empty((len(self.blobs), 3))
         rpy_apply_radii(self.blobs, self.radii, np.ascontiguousarray(v.reshape(-1, 3)), out)
         return out.ravel()

@@ -104,8 +104,8 @@ class RotatingFrame:
     The unknowns are ``z = y[:-1]``, the lab state vector without the motor angle, written in
     the turning frame. The clamp is then at its reference position (``phi = 0``).
 
-    ``blob_body = True`` accepts a fixed no-slip body (:class:`~flagwrap.hydrodynamics.
-    polydisperse.FixedBodyMobility`): its blob shell, not quite symmetric about the axis, is
+    ``blob_body = True`` accepts a fixed no-slip body (:class:`~flagwrap.body.
+    fixed_mobility.FixedBodyMobility`): its blob shell, not quite symmetric about the axis, is
     held at one angle in this frame, where it really turns at ``-omega``. The error is the
     shell's ripple; docs/bacterium.md measures it by turning the shell between two runs.
     """

@@ -28,7 +28,7 @@ E^T V``. The whole map ``G -> dy/dt`` is ``A G`` with
 
     A = A_fixed + (E - S)^T N (E - S),
 
-``A_fixed`` the fixed no-slip body's mobility (:class:`~flagwrap.hydrodynamics.polydisperse.
+``A_fixed`` the fixed no-slip body's mobility (:class:`~flagwrap.body.fixed_mobility.
 FixedBodyMobility`) and the rank-6 term the body's motion: symmetric, positive
 semidefinite, and the total force and torque on the fluid vanish (``K^T lambda + S G = 0``).
 The twist torques act on the fluid locally (the bond's rotational drag), as in the rig.

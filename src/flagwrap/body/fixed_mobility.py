@@ -1,0 +1,91 @@
+"""The beads' mobility beside a fixed no-slip body: the free-space RPY mobility less the
+screening of the body's blobs (rigid multiblob; :mod:`flagwrap.body.multiblob`,
+:mod:`flagwrap.body.solver`). It lives with the body, which it needs, so that the RPY
+kernels (:mod:`flagwrap.hydrodynamics.polydisperse`) import nothing of the body.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from flagwrap.body.solver import LaggedScreening, make_blob_solver, screening_matrix
+from flagwrap.hydrodynamics.polydisperse import rpy_cross_block
+
+
+class FixedBodyMobility:
+    """The beads' mobility beside a fixed body with a no-slip surface (rigid multiblob,
+    :mod:`flagwrap.body.multiblob`).
+
+    The body's blobs carry forces ``lambda`` that hold its surface still. A bead force ``F``
+    moves the blobs at ``M_bf F``, so ``M_bb lambda = -M_bf F``, and the beads move at
+    ``(M_ff - M_fb M_bb^-1 M_bf) F``. That Schur complement is the mobility here. ``M_bb`` is
+    factorised once, since the body does not move (``solver = "direct"``), or solved by
+    conjugate gradients in O(n) memory (``"krylov"``; :mod:`flagwrap.body.solver`). It is
+    symmetric and positive definite, and
+    smaller than ``M_ff``: the surface screens the flow. Viscosity 1; the bead radius is one
+    number, the blobs' radii per blob. It has ``matrix`` and ``apply`` of the mobility
+    interface. ``apply_single`` is ``apply``, and ``near_field_blocks`` (for the banded
+    preconditioner of the Krylov stage solver) are the free beads': a preconditioner may be
+    approximate. Not symmetric about the motor axis (``axisymmetric = False``): the blob shell
+    is not, so the turning frame refuses it.
+    """
+
+    long_range = True
+    backend = "direct+fixed-body"
+    axisymmetric = False
+
+    def __init__(self, radius: float, blobs, blob_radii, solver: str = "direct"):
+        from flagwrap.hydrodynamics.mobility import RPYMobility
+
+        self.radius = float(radius)
+        self.self_mobility = 1.0 / (6.0 * math.pi * self.radius)
+        self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
+        self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
+                                               dtype=np.float64)
+        self._free = RPYMobility(self.radius)
+        self._solver = make_blob_solver(solver, self.blobs, self.blob_radii)
+        self._lagged = LaggedScreening(self._solver, self.blobs, self._cross)
+
+    def _cross(self, x):
+        return rpy_cross_block(x, self.radius, self.blobs, self.blob_radii)
+
+    def screening(self, x) -> np.ndarray:
+        """``M_fb M_bb^-1 M_bf`` (3n, 3n): what the body takes off the free mobility."""
+        return screening_matrix(self._solver, self._cross(x))
+
+    def matrix(self, x, out=None):
+        M = self._free.matrix(x, out=out)
+        M -= self.screening(x)
+        return M
+
+    def stage_matrix(self, x, out=None):
+        """The matrix for the stage solver's ``W`` only (a W-method keeps its order for any
+        ``W``): ``M_ff`` less the screening as last computed, recomputed when the beads have
+        moved (:class:`~flagwrap.body.solver.LaggedScreening`; with the Krylov solver ``M_ff``
+        alone)."""
+        M = self._free.matrix(x, out=out)
+        S = self._lagged(np.ascontiguousarray(x, dtype=np.float64))
+        if S is not None:
+            M -= S
+        return M
+
+    def solver_memory(self) -> np.ndarray:
+        """What :meth:`stage_matrix` carries from step to step
+        (:meth:`~flagwrap.body.solver.LaggedScreening.memory`)."""
+        return self._lagged.memory()
+
+    def restore_solver_memory(self, memory) -> None:
+        self._lagged.restore(memory)
+
+    def near_field_blocks(self, x, width: int):
+        return self._free.near_field_blocks(x, width)
+
+    def apply(self, x, F):
+        F = np.ascontiguousarray(F, dtype=np.float64)
+        C = self._cross(x)
+        lam = self._solver.solve(C.T @ F.ravel())
+        return self._free.apply(x, F) - (C @ lam).reshape(-1, 3)
+
+    apply_single = apply
