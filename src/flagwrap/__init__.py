@@ -16,7 +16,7 @@ __all__ = ["__version__", *_API]
 
 
 def __getattr__(name):
-    if name in ("sweep", "bacteria"):  # packages whose modules are callable (api.CallableModule)
+    if name in ("sweep", "bacteria"):  # packages whose modules are callable (_callable.CallableModule)
         import importlib
 
         return importlib.import_module(f"flagwrap.{name}")

@@ -236,17 +236,5 @@ def bacteria(prefactor: float = 0.06, files=(), only_files: bool = False) -> lis
              "paper_side": s.paper_side} for s in species]
 
 
-class CallableModule(__import__("types").ModuleType):
-    """Module type of the packages ``flagwrap.sweep``, ``flagwrap.bacteria`` and
-    ``flagwrap.stability``, whose names are
-    also API functions: importing a subpackage binds its name on ``flagwrap`` to the module, so
-    the module itself answers the call (``flagwrap.sweep(spec)`` runs :func:`sweep`)."""
-
-    def __call__(self, *args, **kwargs):
-        from flagwrap import api
-
-        return getattr(api, self.__name__.rsplit(".", 1)[1])(*args, **kwargs)
-
-
 __all__ = ["load", "run", "RunResult", "analyze", "critical", "CriticalResult", "stability", "sweep",
            "figure", "bacteria"]

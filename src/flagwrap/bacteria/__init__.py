@@ -12,13 +12,8 @@ from flagwrap.bacteria.species import (
 __all__ = ["Provenance", "Species", "default_species", "format_table", "load_species_file", "parse_species"]
 
 
-def _callable():
-    # ``flagwrap.bacteria(...)`` is the Python API's :func:`flagwrap.api.bacteria` (see CallableModule)
-    import sys
+# ``flagwrap.bacteria(...)`` is the Python API's :func:`flagwrap.api.bacteria`
+# (:class:`flagwrap._callable.CallableModule`)
+from flagwrap._callable import make_callable  # noqa: E402
 
-    from flagwrap.api import CallableModule
-
-    sys.modules[__name__].__class__ = CallableModule
-
-
-_callable()
+make_callable(__name__)

@@ -4,14 +4,8 @@
 :mod:`.boundary` (a sweep's geometries)."""
 
 
-def _callable():
-    # ``flagwrap.stability(...)`` is the Python API's :func:`flagwrap.api.stability` (see
-    # CallableModule): importing this package binds its name on ``flagwrap`` to the module
-    import sys
+# ``flagwrap.stability(...)`` is the Python API's :func:`flagwrap.api.stability`
+# (:class:`flagwrap._callable.CallableModule`)
+from flagwrap._callable import make_callable  # noqa: E402
 
-    from flagwrap.api import CallableModule
-
-    sys.modules[__name__].__class__ = CallableModule
-
-
-_callable()
+make_callable(__name__)

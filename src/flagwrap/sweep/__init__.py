@@ -14,13 +14,8 @@ from flagwrap.sweep.store import SweepStore
 __all__ = ["Case", "SweepSpec", "SweepStore", "load_spec", "resolve_geometry", "spec_from_dict"]
 
 
-def _callable():
-    # ``flagwrap.sweep(...)`` is the Python API's :func:`flagwrap.api.sweep` (see CallableModule)
-    import sys
+# ``flagwrap.sweep(...)`` is the Python API's :func:`flagwrap.api.sweep`
+# (:class:`flagwrap._callable.CallableModule`)
+from flagwrap._callable import make_callable  # noqa: E402
 
-    from flagwrap.api import CallableModule
-
-    sys.modules[__name__].__class__ = CallableModule
-
-
-_callable()
+make_callable(__name__)
