@@ -122,9 +122,10 @@ class Simulation:
         # leave the records with different lengths
         phi = y[s.i_phi]
         hook = s.joint_observables(info, m1, m2)
-        rate = s.motor_rate(y, info_in, omega)  # a torque motor's own rate
+        # a torque motor's own rate (several: the first motor's)
+        rate = float(np.ravel(s.motor_rate(y, info_in, omega))[0])
         row = (t, info.x.copy(), info.theta.copy(), m1, phi, rate,
-               s.motor_torque(info_in, phi, omega), info.elastic_energy, info.contact_energy,
+               s.motor_torque(info_in, phi, omega, y), info.elastic_energy, info.contact_energy,
                float(np.min(info.distance[s.free_beads])) if s.nb else np.inf,
                self._strain(info), info.interaction_energy) + hook
         body = getattr(s, "body_record", None)  # a moving body's pose and velocities

@@ -130,11 +130,27 @@ def test_single_filament_attributes_refuse_by_name_on_several():
             getattr(s, name)
 
 
-def test_several_filaments_refuse_a_torque_motor():
-    cfg = _cfg()
-    cfg = cfg.replace(motor=dataclasses.replace(cfg.motor, kind="torque", stall_torque=1e-4))
-    with pytest.raises(UserInputError, match="motor.kind = 'torque': several flagella"):
-        RodSystem(cfg, placements=[Placement(), Placement(origin=(1.0, 0.0, 0.0))])
+def test_torque_motors_of_two_filaments_far_apart_each_turn_as_the_single_one():
+    # each motor's angle is an unknown with its own torque balance: with HI off and 3 L
+    # apart, each filament and its motor's rate are the single torque-speed run's to
+    # rounding. The torque motors take the dense LU of W (the speed test's banded one): two
+    # factorisations of different size differ by eps kappa(W) ~ 1e-16 x 1e4 per step, over
+    # ~450 steps <= 1e-10 L, five orders below the step's error tolerance
+    cfg = _cfg(hi=False)
+    cfg = cfg.replace(initial=dataclasses.replace(cfg.initial, perturbation=0.0),
+                      motor=dataclasses.replace(cfg.motor, kind="torque-speed",
+                                                stall_torque=2e-4, zero_load_speed=0.02))
+    one_sys, one = _run(cfg)
+    s, two = _run(cfg, [Placement(), Placement(origin=(3.0, 0.0, 0.0))])
+    assert s.layout.block("phi").size == 2 and s.layout.block("phi").kind == "angle"
+    assert one.ok and two.ok and len(one.t) == len(two.t)
+    N = s.parts[0].N
+    x1, x2 = np.asarray(one.x), np.asarray(two.x)
+    np.testing.assert_allclose(x2[:, :N], x1, atol=1e-10, rtol=0)
+    np.testing.assert_allclose(x2[:, N:] - [3.0, 0.0, 0.0], x1, atol=1e-10, rtol=0)
+    np.testing.assert_allclose(two.omega, one.omega, rtol=1e-9)  # motor 0's own rate
+    np.testing.assert_allclose(two.motor_torque, 2 * np.asarray(one.motor_torque), rtol=1e-9)
+    assert abs(np.asarray(one.omega)[-1] - 1.0) > 1e-3  # it turns at its load, not at omega
 
 
 def test_placement_turns_the_default_axis_onto_the_given_one():

@@ -79,15 +79,16 @@ def lu_of_transpose(WT):
 
 
 def add_motor_rows(WT, system, y, base, gamma_h, omega) -> None:
-    """A torque motor's row of ``W = I - gamma h Mob J`` in ``WT = W^T``
-    (:meth:`~flagwrap.system.rod_system.RodSystem.motor_jacobian`); the force Jacobian's
-    motor-angle column is in ``J`` already."""
+    """The torque motors' rows of ``W = I - gamma h Mob J`` in ``WT = W^T``
+    (:meth:`~flagwrap.system.rod_system.RodSystem.motor_jacobian`, one per motor); the force
+    Jacobian's motor-angle columns are in ``J`` already."""
     if omega is None:
         raise ValueError("a torque motor's W needs the phase's omega")
-    row = system.motor_jacobian(y, base, omega)
-    i = system.i_phi
-    WT[:, i] = -gamma_h * row
-    WT[i, i] += 1.0
+    rows = np.atleast_2d(system.motor_jacobian(y, base, omega))
+    for k, row in enumerate(rows):
+        i = system.i_phi + k
+        WT[:, i] = -gamma_h * row
+        WT[i, i] += 1.0
 
 
 def preconditioner_width(system) -> int:

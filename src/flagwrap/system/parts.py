@@ -278,9 +278,6 @@ def check_flagella(config) -> None:
             if not float(n @ np.asarray(f.axis, float)) > 0.0:
                 raise UserInputError(f"{where}.axis = {list(f.axis)} points into the body; the "
                                      "motor axis must point out of it")
-    if len(config.flagella) > 1 and config.motor.kind != "speed":
-        raise UserInputError(f"motor.kind = {config.motor.kind!r}: several flagella run on speed "
-                             "motors only for now (motor.kind = \"speed\")")
     if len(config.flagella) > 1 and config.numerics.frame != "lab":
         raise UserInputError(f"numerics.frame = {config.numerics.frame!r} needs one flagellum on "
                              f"the motor axis; this config has {len(config.flagella)} "

@@ -94,11 +94,11 @@ class RodSystem:
         :func:`flagwrap.joints.make_joint` from ``config.joint``); ``interactions``: extra
         energy terms (:mod:`flagwrap.interactions.base`) after those the config asks for;
         ``placements``: one :class:`~flagwrap.system.parts.Placement` per filament (default:
-        the config's ``[[flagellum]]`` tables, or one filament at the origin), each a copy of the config's filament and joint on its
-        own speed motor (the motors turn together, by ``config.motor``'s protocol);
+        the config's ``[[flagellum]]`` tables, or one filament at the origin), each a copy
+        of the config's filament and joint on its own motor of ``config.motor``'s law and
+        protocol (speed motors turn together; torque motors each at its own load);
         ``drive``: a motor law object (:mod:`flagwrap.motor.drive`'s interface; default
-        :func:`~flagwrap.motor.drive.make_drive` from ``config.motor``), one filament only
-        when its angle is free (``drive.free``)."""
+        :func:`~flagwrap.motor.drive.make_drive` from ``config.motor``), every motor's."""
         self.config = config
         fil = config.filament
         L = fil.length
@@ -156,12 +156,6 @@ class RodSystem:
             self.body = body or NoBody()
         self._has_body = not isinstance(self.body, NoBody)
         self.schedule = Schedule(config.motor.protocol)
-        if len(parts) > 1 and self.drive.free:
-            from flagwrap.errors import UserInputError
-
-            raise UserInputError(
-                f"motor.kind = {self.drive.kind!r}: several flagella run on speed motors "
-                "only for now (motor.kind = \"speed\")")
         self.interactions = self._config_interactions() + list(interactions)
 
     def _assemble(self, config) -> None:
@@ -376,38 +370,50 @@ class RodSystem:
         f[self.sl_phi] = self.motor_rate(y, info, omega)
         return f
 
-    def motor_rate(self, y, info: ForceInfo, omega: float) -> float:
+    def motor_rate(self, y, info: ForceInfo, omega: float):
         """``dphi/dt``: the protocol's ``omega`` for a speed motor, the rotor's torque balance
-        for a torque motor (:mod:`flagwrap.motor.drive`)."""
+        for a torque motor (:mod:`flagwrap.motor.drive`); with several torque motors an
+        array, each at its own load."""
         if not self.drive.free:
             return omega
-        return self.drive.rate(omega, self.motor_force(y, info))
+        if len(self.parts) == 1:
+            return self.drive.rate(omega, self.motor_force(y, info))
+        return np.array([self.drive.rate(omega, self.motor_force(y, info, k))
+                         for k in range(len(self.parts))])
 
-    def motor_force(self, y, info: ForceInfo) -> float:
-        """``G_phi = -dE/dphi``, the filament's elastic torque on the rotor [A/L]."""
-        return -self.clamp.generalized_force(y[self.i_phi], info.grad_x, info.grad_theta)
+    def motor_force(self, y, info: ForceInfo, motor: int = 0) -> float:
+        """``G_phi = -dE/dphi`` of motor ``motor``, its filament's elastic torque on the rotor
+        [A/L]."""
+        if len(self.parts) == 1:
+            return -self.clamp.generalized_force(y[self.i_phi], info.grad_x, info.grad_theta)
+        p = self.parts[motor]
+        return -p.joint.generalized_force(y[self.i_phi + motor], info.grad_x[p.beads],
+                                          info.grad_theta[p.bonds])
 
     def motor_jacobian(self, y, base, omega: float):
-        """For a torque motor: the motor's row of ``Mob J``, ``m dG_phi/dy`` by central
-        differences over the unknowns the rotor couples to (the clamp's neighbours), ``m`` the
-        drive's mobility; ``None`` for a speed motor, whose angle is prescribed. (The force
-        Jacobian's motor-angle column is the kernel's own: ``force_jacobian_coo``.)"""
+        """For torque motors: each motor's row of ``Mob J`` (n_motors, ny), ``m dG_phi/dy`` by
+        central differences over the unknowns its rotor couples to (its clamp's neighbours),
+        ``m`` the drive's mobility; ``None`` for speed motors, whose angles are prescribed.
+        (The force Jacobian's motor-angle columns are the kernel's own: ``force_jacobian_coo``.)"""
         if not self.drive.free:
             return None
         h = self.fd_step
         m = self.drive.mobility(omega)
-        row = np.zeros(self.ny)
-        near = [3 * k + c for k in range(min(3, self.nb)) for c in range(3)]
-        near += [self.sl_th.start + j for j in range(min(3, self.ne))] + [self.i_phi]
+        rows = np.zeros((len(self.parts), self.ny))
         yp = np.array(y, float)
-        for k in near:
-            yp[k] = y[k] + h
-            gp = self.motor_force(yp, self.forces(yp, base))
-            yp[k] = y[k] - h
-            gm = self.motor_force(yp, self.forces(yp, base))
-            yp[k] = y[k]
-            row[k] = m * (gp - gm) / (2 * h)
-        return row
+        for motor, p in enumerate(self.parts):
+            near = [3 * k + c for k in range(min(3, p.nb)) for c in range(3)]
+            near += [3 * p.nb + j for j in range(min(3, p.ne))] + [p.ny - 1]  # its own order
+            if p.ymap is not None:
+                near = p.ymap[near]
+            for k in near:
+                yp[k] = y[k] + h
+                gp = self.motor_force(yp, self.forces(yp, base), motor)
+                yp[k] = y[k] - h
+                gm = self.motor_force(yp, self.forces(yp, base), motor)
+                yp[k] = y[k]
+                rows[motor, k] = m * (gp - gm) / (2 * h)
+        return rows
 
     def rhs(self, y, base, omega):
         info = self.forces(y, base)
@@ -543,26 +549,32 @@ class RodSystem:
         return sp.csr_matrix((vals, (rows, cols)), shape=(self.ny, self.ny))
 
     # observables ---------------------------------------------------------------------------
-    def motor_torque(self, info: ForceInfo, phi: float, omega: float) -> float:
+    def motor_torque(self, info: ForceInfo, phi: float, omega: float, y=None) -> float:
         """Axial torque the motor supplies [A/L], about the outward axis (positive = CCW);
-        with several filaments, the sum over their motors (:meth:`motor_torques`).
+        with several filaments, the sum over their motors (:meth:`motor_torques`; torque
+        motors need the state ``y`` for their own angles).
 
         Torque balance on the driven DOF: ``N_m = dE/dphi + zeta_r0 omega`` with
         ``zeta_r0 = M 8 pi a^3 w_0`` the rotational drag of the clamped bond. A torque motor
         exerts its own torque (:mod:`flagwrap.motor.drive`) at the rate it turns.
         """
         if len(self.parts) > 1:
-            return float(np.sum(self.motor_torques(info, phi, omega)))
+            return float(np.sum(self.motor_torques(info, phi, omega, y)))
         dEdphi = self.clamp.generalized_force(phi, info.grad_x, info.grad_theta)
         if not self.drive.free:
             return dEdphi + self.machin * self.rot_drag[0] * omega
         return self.drive.torque(self.drive.rate(omega, -dEdphi), omega)
 
-    def motor_torques(self, info: ForceInfo, phi: float, omega: float) -> np.ndarray:
-        """Each speed motor's axial torque [A/L] about its own axis, (n_filaments,); the
-        motors turn together, all at angle ``phi``."""
-        if self.drive.free:
+    def motor_torques(self, info: ForceInfo, phi: float, omega: float, y=None) -> np.ndarray:
+        """Each motor's axial torque [A/L] about its own axis, (n_filaments,): speed motors
+        turn together, all at angle ``phi``; torque motors at their own angles in ``y``."""
+        if len(self.parts) == 1:
             return np.array([self.motor_torque(info, phi, omega)])
+        if self.drive.free:
+            if y is None:
+                raise ValueError("motor_torques: torque motors need the state y")
+            return np.array([self.drive.torque(self.drive.rate(omega, self.motor_force(y, info, k)),
+                                               omega) for k in range(len(self.parts))])
         return np.array([p.joint.generalized_force(phi, info.grad_x[p.beads],
                                                    info.grad_theta[p.bonds])
                          + self.machin * p.rot_drag[0] * omega for p in self.parts])

@@ -273,7 +273,7 @@ class RotatingSystem:
     def interaction_jacobian_coo(self, y, which: str = "all"):
         return self.inner.interaction_jacobian_coo(self._at_zero(y), which)
 
-    def motor_torque(self, info, phi: float, omega: float) -> float:
+    def motor_torque(self, info, phi: float, omega: float, y=None) -> float:
         """The lab system's, from forces evaluated here with the clamp at ``phi = 0``."""
         return self.inner.motor_torque(info, 0.0, omega)
 
