@@ -220,13 +220,10 @@ def figure(name: str, outdir="out/figures") -> list:
 def bacteria(prefactor: float = 0.06, files=(), only_files: bool = False) -> list:
     """``flagwrap bacteria``: the species on the stability diagram, one dict per species
     (``M``, ``(R/L)^3``, ``M_c`` and ``M/M_c`` for ``M_c = prefactor (R/L)^-3``, side)."""
-    import math
-
     from flagwrap.bacteria.species import default_species, load_species_file
-    from flagwrap.errors import UserInputError
+    from flagwrap.errors import check_positive
 
-    if not (isinstance(prefactor, (int, float)) and math.isfinite(prefactor) and prefactor > 0):
-        raise UserInputError(f"prefactor must be a finite number > 0, got {prefactor!r}")
+    check_positive("prefactor", prefactor)
     species = [] if only_files else default_species()
     for f in files:
         species += load_species_file(f)

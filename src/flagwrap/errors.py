@@ -1,4 +1,8 @@
-"""Exceptions with a user-facing meaning."""
+"""Exceptions with a user-facing meaning, and the one check of a number's range that raises
+them (every module that validates a number calls :func:`check_finite` or
+:func:`check_positive`)."""
+
+import math
 
 
 class UserInputError(ValueError):
@@ -12,3 +16,29 @@ class SimulationError(RuntimeError):
 class OutputWriteError(UserInputError):
     """A finished result could not be written where asked (disk full, folder gone); the
     message names where it was kept instead. Exit code 1 (the input was fine)."""
+
+
+def check_finite(name: str, value) -> float:
+    """``value`` as a float, or a one-line :class:`UserInputError` naming ``name``: not a
+    number (a bool is not one), or not finite."""
+    import numpy as np
+
+    if isinstance(value, (bool, np.bool_)):
+        raise UserInputError(f"{name} must be a number, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise UserInputError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise UserInputError(f"{name} must be finite, got {value!r}")
+    return v
+
+
+def check_positive(name: str, value, unit: str = "", allow_zero: bool = False) -> float:
+    """:func:`check_finite`, then ``> 0`` (``>= 0`` with ``allow_zero``); ``unit`` is named in
+    the message."""
+    v = check_finite(name, value)
+    if v < 0 or (v == 0 and not allow_zero):
+        raise UserInputError(f"{name} must be {'>=' if allow_zero else '>'} 0"
+                             f"{(' ' + unit) if unit else ''}, got {value!r}")
+    return v

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flagwrap import units
-from flagwrap.errors import UserInputError
+from flagwrap.errors import UserInputError, check_finite, check_positive
 
 #: prefactor of the paper's stability line M_c = 0.06 (R/L)^-3 (main text, Fig. 5)
 PAPER_MC_PREFACTOR = 0.06
@@ -39,23 +39,9 @@ MAX_BLOBS = 4000
 MAX_BLOBS_KRYLOV = 20000
 
 
-def _finite(name: str, value) -> float:
-    if isinstance(value, (bool, np.bool_)):
-        raise UserInputError(f"{name} must be a number, got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise UserInputError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise UserInputError(f"{name} must be finite, got {value!r}")
-    return v
-
-
-def _positive(name: str, value, unit: str = "") -> float:
-    v = _finite(name, value)
-    if v <= 0:
-        raise UserInputError(f"{name} must be > 0{(' ' + unit) if unit else ''}, got {value!r}")
-    return v
+# the one range check (flagwrap.errors), under the names this module has always used
+_finite = check_finite
+_positive = check_positive
 
 
 def _set(obj, name, value):

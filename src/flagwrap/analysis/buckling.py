@@ -62,11 +62,9 @@ without encircling it) does not reach.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from flagwrap.errors import UserInputError
+from flagwrap.errors import UserInputError, check_positive
 from flagwrap.observables import (
     cw_torque_peak,
     free_end_height,
@@ -82,10 +80,7 @@ STATES = ("stable", "folding", "wrapping")
 
 
 def _positive(name, value, allow_zero=False):
-    v = float(value)
-    if not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
-        raise UserInputError(f"{name} must be a finite number {'>=' if allow_zero else '>'} 0, got {value!r}")
-    return v
+    return check_positive(name, value, allow_zero=allow_zero)
 
 
 def _series(turns, *arrays):

@@ -15,8 +15,6 @@ the defaults here are kg/m^3).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -40,10 +38,9 @@ RHO_GLYCERIN = 1250.0
 
 
 def _pos(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v > 0.0):
-        raise UserInputError(f"{name} must be a finite number > 0, got {value!r}")
-    return v
+    from flagwrap.errors import check_positive
+
+    return check_positive(name, value)
 
 
 def effective_density(

@@ -50,10 +50,9 @@ REFERENCE_TEMPERATURE = 293.15
 
 
 def _pos(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v > 0.0):
-        raise UserInputError(f"{name} must be a finite number > 0, got {value!r}")
-    return v
+    from flagwrap.errors import check_positive
+
+    return check_positive(name, value)
 
 
 @dataclass(frozen=True)

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from flagwrap.errors import UserInputError
+from flagwrap.errors import UserInputError, check_positive
 
 
 def positions_array(positions, min_beads: int = 2) -> np.ndarray:
@@ -20,7 +18,5 @@ def positions_array(positions, min_beads: int = 2) -> np.ndarray:
 
 
 def positive(name: str, value) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v > 0.0):
-        raise UserInputError(f"{name} must be a finite number > 0, got {value!r}")
-    return v
+    """``value`` checked finite and > 0 (:func:`flagwrap.errors.check_positive`)."""
+    return check_positive(name, value)

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from flagwrap.errors import UserInputError
+from flagwrap.errors import UserInputError, check_positive
 
 __all__ = [
     "StretchedHelix",
@@ -56,10 +56,7 @@ __all__ = [
 
 
 def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise UserInputError(f"{name} must be a finite number > 0, got {value!r}")
-    return value
+    return check_positive(name, value)
 
 
 def helix_curvature_torsion(radius: float, pitch: float) -> tuple[float, float]:
