@@ -148,3 +148,19 @@ def test_analyze_and_its_figure_on_a_free_cell_with_two_flagella(tmp_path, capsy
     res = json.loads(capsys.readouterr().out)
     assert len(res["filaments"]) == 2 and "separation" in res["bundle"]
     assert png.is_file() and png.stat().st_size > 10_000
+
+
+def test_rebuilt_elastic_energy_of_each_flagellum_adds_up_to_the_simulators(two_run):
+    # oracle: the simulator's stored elastic energy, every saved frame; each flagellum's
+    # rebuilt with its own rest state (its own reference frames: the copies' differ)
+    from flagwrap.io.runfile import config_of, filament_slices, read_run
+    from flagwrap.io.vtk import ElasticForces
+
+    ds = read_run(two_run)
+    ef = ElasticForces(config_of(ds))
+    sl = filament_slices(ds)
+    E = []
+    for x, m in zip(ds["position"].values, ds["director"].values):
+        E.append(sum(ef(x[s], m[s.start - k:s.stop - k - 1], k)[0] for k, s in enumerate(sl)))
+    ref = ds["elastic_energy"].values
+    np.testing.assert_allclose(E, ref, rtol=1e-8, atol=1e-12 * ref.max())

@@ -126,21 +126,21 @@ class ElasticForces:
 
     Notes
     -----
-    Builds :class:`flagwrap.system.rod_system.RodSystem` once (for the rest state and scales); each call
-    costs one energy-gradient evaluation.
+    Builds the run's filaments once (:func:`flagwrap.system.parts.build_parts`: their rest
+    states, no mobility or body); each call costs one energy-gradient evaluation.
     """
 
     def __init__(self, config):
-        from flagwrap.system.rod_system import RodSystem
+        from flagwrap.system.parts import build_parts
 
-        self.system = RodSystem(config)
+        self.parts = build_parts(config)
         self.L = config.scales.length
         self.force_scale = config.scales.force
         self.energy_scale = config.scales.energy
 
     def rest_twist(self, filament: int = 0) -> np.ndarray:
         """Rest twist ``m_i^0`` [rad] per bead (N,) of flagellum ``filament``."""
-        return np.asarray(self.system.parts[filament].rest.mbar, float)
+        return np.asarray(self.parts[filament].rest.mbar, float)
 
     def __call__(self, x: np.ndarray, m1: np.ndarray, filament: int = 0):
         """Elastic energy [J] and forces ``-dE/dx`` (N, 3) [N] of one frame of one flagellum.
@@ -159,7 +159,7 @@ class ElasticForces:
         theta = np.arctan2(np.einsum("ij,ij->i", m1, d2), np.einsum("ij,ij->i", m1, d1))
         theta = np.unwrap(theta)  # adjacent differences in (-pi, pi]
         base = Frames(t, d1, np.zeros(len(xc)))
-        E, f, _, _ = elastic_forces(xc, theta, base, self.system.parts[filament].rest)
+        E, f, _, _ = elastic_forces(xc, theta, base, self.parts[filament].rest)
         return E * self.energy_scale, f * self.force_scale
 
 

@@ -225,6 +225,41 @@ class FilamentPart:
         return self.colors
 
 
+def build_parts(config, placements=None, x0=None, theta0=None, joint=None) -> list:
+    """The config's filaments as :class:`FilamentPart` s (core units), nothing else built
+    (no mobility, no body): one per ``placements`` entry (default: the ``[[flagellum]]``
+    tables, or one at the pole). ``x0``, ``theta0``, ``joint``: one filament's own shape and
+    joint instead of the config's (:class:`~flagwrap.system.rod_system.RodSystem`'s
+    arguments)."""
+    from flagwrap.geometry.helix import filament_positions
+    from flagwrap.joints import make_joint
+
+    fil = config.filament
+    L = fil.length
+    if placements is None:  # the config's [[flagellum]] tables, or one at the pole
+        placements = placements_from_config(config) or [Placement()]
+    placements = list(placements)
+    if not placements:
+        raise ValueError("build_parts: placements must hold at least one filament")
+    if len(placements) > 1 and (x0 is not None or joint is not None):
+        raise ValueError("build_parts: a given x0 or joint is for one filament, not several")
+    b = fil.bond_length / L
+    parts = []
+    for k, place in enumerate(placements):
+        xk = filament_positions(fil, config.clamp) / L if x0 is None else np.asarray(x0, float)
+        thk = np.zeros(len(xk) - 1) if theta0 is None else np.asarray(theta0, float)
+        xk = place.apply(xk)
+        jk = joint
+        if jk is None:  # the joint may add beads (a resolved hook): it returns the shape
+            jk, xk, thk = make_joint(config, xk, thk, axis=tuple(place.axis), origin=place.origin)
+        parts.append(FilamentPart(
+            xk, thk, jk, bond=b, twist=fil.twist_modulus / fil.bending_modulus,
+            stretch=fil.stretch_stiffness / b**3, radius=fil.bead_radius / L,
+            gravity_number=config.gravity_number if fil.density is not None else None,
+            name=f"flagellum{k}"))
+    return parts
+
+
 def placements_from_config(config) -> list | None:
     """One :class:`Placement` per ``[[flagellum]]`` table (core units), or None (no table:
     one flagellum at the pole, the identity)."""

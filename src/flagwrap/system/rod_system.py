@@ -29,13 +29,11 @@ import numpy as np
 from flagwrap.system import kernels as SK
 from flagwrap.body.cell_body import CappedCylinder, NoBody, body_mobility
 from flagwrap.elasticity.rod import Frames
-from flagwrap.geometry.helix import filament_positions
 from flagwrap.hydrodynamics.mobility import make_mobility
-from flagwrap.joints import make_joint
 from flagwrap.motor.drive import make_drive
 from flagwrap.motor.protocol import Schedule
 from flagwrap.system.layout import DofLayout
-from flagwrap.system.parts import FilamentPart, Placement, placements_from_config
+from flagwrap.system.parts import build_parts
 
 
 @dataclass
@@ -104,13 +102,6 @@ class RodSystem:
         L = fil.length
         self.scales = config.scales
         self.machin = config.machin
-        if placements is None:  # the config's [[flagellum]] tables, or one at the pole
-            placements = placements_from_config(config) or [Placement()]
-        placements = list(placements)
-        if not placements:
-            raise ValueError("RodSystem: placements must hold at least one filament")
-        if len(placements) > 1 and (x0 is not None or (joint or clamp) is not None):
-            raise ValueError("RodSystem: a given x0 or joint is for one filament, not several")
         b = fil.bond_length / L
         self.bond = b
         # Step of the coloured finite-difference Jacobian, a fixed fraction of the bond: bending
@@ -118,21 +109,7 @@ class RodSystem:
         # relative accuracy of J the same at every N (measured: docs/numerics.md, "Cost").
         self.fd_step = 6e-6 * b
         self.radius = fil.bead_radius / L  # hydrodynamics (radius in core units)
-        parts = []
-        for k, place in enumerate(placements):
-            xk = filament_positions(fil, config.clamp) / L if x0 is None else np.asarray(x0, float)
-            thk = np.zeros(len(xk) - 1) if theta0 is None else np.asarray(theta0, float)
-            xk = place.apply(xk)
-            jk = joint or clamp
-            if jk is None:  # the joint may add beads (a resolved hook): it returns the shape
-                jk, xk, thk = make_joint(config, xk, thk, axis=tuple(place.axis),
-                                         origin=place.origin)
-            parts.append(FilamentPart(
-                xk, thk, jk, bond=b, twist=fil.twist_modulus / fil.bending_modulus,
-                stretch=fil.stretch_stiffness / b**3, radius=self.radius,
-                gravity_number=config.gravity_number if fil.density is not None else None,
-                name=f"flagellum{k}"))
-        self.parts = parts
+        parts = self.parts = build_parts(config, placements, x0, theta0, joint or clamp)
         # the motor law: its angle is an unknown (layout kind "angle") when the law is free
         self.drive = drive or make_drive(config, zeta=self.machin * parts[0].rot_drag[0])
         self._assemble(config)
