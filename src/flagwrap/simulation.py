@@ -64,6 +64,9 @@ class Trajectory:
     #: a free body's [X (3), q (4), U (3), Omega (3)] per frame (lab frame, core units);
     #: empty for a fixed body
     body: list = field(default_factory=list)
+    #: several flagella: each motor's torque [A/L] then its rate [omega] per frame, (2 n,);
+    #: empty for one
+    motors: list = field(default_factory=list)
     status: str = "running"
     message: str = ""
     n_steps: int = 0
@@ -79,6 +82,8 @@ class Trajectory:
         out = {k: np.asarray(getattr(self, k)) for k in _RECORDS}
         if self.body:
             out["body"] = np.asarray(self.body)
+        if self.motors:
+            out["motors"] = np.asarray(self.motors)
         return out
 
 
@@ -130,10 +135,17 @@ class Simulation:
                self._strain(info), info.interaction_energy) + hook
         body = getattr(s, "body_record", None)  # a moving body's pose and velocities
         body = None if body is None else body(y, info_in)
+        motors = None
+        if s.n_filaments > 1:  # every motor's torque and rate
+            motors = np.concatenate([s.motor_torques(info_in, phi, omega, y),
+                                     np.broadcast_to(s.motor_rate(y, info_in, omega),
+                                                     (s.n_filaments,))])
         for name, value in zip(_RECORDS, row):
             getattr(traj, name).append(value)
         if body is not None:
             traj.body.append(body)
+        if motors is not None:
+            traj.motors.append(motors)
 
     def _strain(self, info) -> float:
         ln = self.system.bond_lengths(info.x)

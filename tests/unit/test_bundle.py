@@ -148,6 +148,13 @@ def test_analyze_and_its_figure_on_a_free_cell_with_two_flagella(tmp_path, capsy
     res = json.loads(capsys.readouterr().out)
     assert len(res["filaments"]) == 2 and "separation" in res["bundle"]
     assert png.is_file() and png.stat().st_size > 10_000
+    from flagwrap.io.runfile import read_run
+
+    ds = read_run(path)  # every motor's torque and rate, in SI
+    assert ds["motor_torques"].dims == ("time", "filament")
+    np.testing.assert_allclose(ds["motor_torques"].values.sum(axis=1), ds["motor_torque"].values,
+                               rtol=1e-12)
+    np.testing.assert_allclose(ds["motor_rates"].values[:, 1], ds["omega"].values, rtol=1e-12)
 
 
 def test_rebuilt_elastic_energy_of_each_flagellum_adds_up_to_the_simulators(two_run):

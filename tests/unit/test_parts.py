@@ -151,6 +151,11 @@ def test_torque_motors_of_two_filaments_far_apart_each_turn_as_the_single_one():
     np.testing.assert_allclose(two.omega, one.omega, rtol=1e-9)  # motor 0's own rate
     np.testing.assert_allclose(two.motor_torque, 2 * np.asarray(one.motor_torque), rtol=1e-9)
     assert abs(np.asarray(one.omega)[-1] - 1.0) > 1e-3  # it turns at its load, not at omega
+    # each motor recorded: torques add up to the total, rates equal by symmetry
+    m = np.asarray(two.motors)
+    np.testing.assert_allclose(m[:, :2].sum(axis=1), two.motor_torque, rtol=1e-12)
+    np.testing.assert_allclose(m[:, 2], two.omega, rtol=0)
+    np.testing.assert_allclose(m[:, 3], m[:, 2], rtol=1e-9)
 
 
 def test_placement_turns_the_default_axis_onto_the_given_one():

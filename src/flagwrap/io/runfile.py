@@ -131,6 +131,12 @@ def trajectory_dataset(traj):
         ds["tip_positions"] = (("time", "filament", "xyz"), x_si[:, first + n - 1, :],
                                {"units": "m", "long_name": "free end of flagellum k"})
         ds.attrs["n_flagella"] = nf
+        if "motors" in a:  # each motor's torque and rate (core -> SI)
+            m = a["motors"]
+            ds["motor_torques"] = (("time", "filament"), m[:, :nf] * sc.torque,
+                                   {"units": "N m", "long_name": "torque of flagellum k's motor"})
+            ds["motor_rates"] = (("time", "filament"), m[:, nf:] * sc.omega,
+                                 {"units": "rad/s", "long_name": "rate of flagellum k's motor"})
     if "body" in a:  # a free body's pose and velocities (core -> SI)
         b = a["body"]
         ds["body_position"] = (("time", "xyz"), b[:, :3] * L, {"units": "m"})
