@@ -28,10 +28,17 @@ body_position          (time, xyz)            a free body's reference point (the
 body_orientation       (time, quat)           its unit quaternion (w, x, y, z), body -> lab
 body_velocity          (time, xyz)            its velocity [m/s]
 body_angular_velocity  (time, xyz)            its angular velocity [rad/s]
+filament_first_bead    (filament)             several flagella: flagellum k's first bead
+filament_n_beads       (filament)             its bead count
+tip_positions          (time, filament, xyz)  each flagellum's free end [m]
+motor_torques          (time, filament)       each motor's torque [N m] (sum: motor_torque)
+motor_rates            (time, filament)       each motor's rate [rad/s]
 =====================  =====================  ==============================================
 
 The four ``body_*`` variables are written for a free body (``body.motion = "free"``) only;
-a fixed body sits at the origin with the identity orientation.
+a fixed body sits at the origin with the identity orientation. The ``filament`` variables
+are written for several flagella (``[[flagellum]]`` tables) only: ``position`` then holds
+them one after the other, ``omega`` and the ``hook_*`` records are flagellum 0's.
 
 Global attributes: ``flagwrap_version``, ``format_version``, ``config_toml`` (the full input,
 re-loadable), ``status`` ("completed" or "failed"), ``message``, ``machin`` (M), ``reynolds``,
