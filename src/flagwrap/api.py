@@ -151,14 +151,11 @@ def critical(config, rtol: float = 0.05, cw_turns: float = 10.0, ccw_turns: floa
              max_runs: int = 16, hydrodynamics=None, on_run=None) -> CriticalResult:
     """``flagwrap critical``: M_c by bracketing and bisection (cached test runs); the option
     ranges are those of the command."""
-    import argparse
+    from flagwrap.analysis.critical import CriticalSearch, RunCache, check_search_options
+    from flagwrap.io.outputs import check_output_dir
 
-    from flagwrap.analysis.critical import CriticalSearch, RunCache
-    from flagwrap.cli.critical import _check_options
-
-    _check_options(argparse.Namespace(rtol=rtol, cw_turns=cw_turns, ccw_turns=ccw_turns,
-                                      factor=factor, max_runs=max_runs, guess=guess,
-                                      bracket=bracket, cache=cache))
+    check_search_options(rtol, cw_turns, ccw_turns, factor, max_runs, guess, bracket)
+    check_output_dir(cache, "cache")
     cfg = _with_numerics(load(config), hydrodynamics)
     search = CriticalSearch(rtol=rtol, cw_turns=cw_turns, ccw_turns=ccw_turns, factor=factor,
                             max_runs=max_runs, cache=RunCache(cache), on_run=on_run)
@@ -175,16 +172,13 @@ def stability(config, direction: str = "cw", m_start: float = 10.0, m_max=None,
     (:class:`flagwrap.stability.threshold.StabilityResult`: ``machin_c``, ``bracket``,
     ``crossing``, ``eigenvalue``, ``mode_frequency``, ``omega_c``, ``branch``, ``summary()``);
     the option ranges are those of the command."""
-    import argparse
-
-    from flagwrap.cli.stability import check_options
     from flagwrap.errors import UserInputError
-    from flagwrap.stability.threshold import DIRECTIONS, critical_from_config
+    from flagwrap.stability.threshold import (DIRECTIONS, check_continuation_options,
+                                              critical_from_config)
 
     if direction not in DIRECTIONS:
         raise UserInputError(f"direction must be 'cw' or 'ccw', got {direction!r}")
-    check_options(argparse.Namespace(m_start=m_start, m_max=m_max, rtol=rtol, factor=factor,
-                                     mode=None, vtk=None))
+    check_continuation_options(m_start, m_max, rtol, factor)
     cfg = _with_numerics(load(config), hydrodynamics)
     return critical_from_config(cfg, direction, m_start=m_start, m_max=m_max, factor=factor,
                                 rtol=rtol, on_point=on_point)

@@ -285,10 +285,13 @@ def test_python_api_is_exported_and_checks_input(tmp_path):
     import flagwrap.stability.threshold  # noqa: F401  (binds the subpackage on flagwrap)
 
     assert callable(flagwrap.stability)  # the package answers the API call
-    with pytest.raises(UserInputError, match="--rtol"):
+    # the API checks through the library and names its own keywords, not the CLI's flags
+    with pytest.raises(UserInputError, match=r"^rtol must be in \(0, 0.5\]"):
         flagwrap.stability("fig4a", rtol=2.0)
-    with pytest.raises(UserInputError, match="--cw-turns"):
+    with pytest.raises(UserInputError, match=r"^cw_turns must be in \[4, 1000\]"):
         flagwrap.critical("fig4a", cw_turns=3, cache=tmp_path)
+    with pytest.raises(UserInputError, match=r"^max_runs must be an integer"):
+        flagwrap.critical("fig4a", max_runs=2.5, cache=tmp_path)
     with pytest.raises(UserInputError, match="unknown figure"):
         flagwrap.figure("fig99", outdir=tmp_path)
     with pytest.raises(UserInputError, match="prefactor"):

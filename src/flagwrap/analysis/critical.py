@@ -117,6 +117,58 @@ def probe_config(cfg, machin: float, ccw_turns: float = 5.0, cw_turns: float = 1
 RUNNER_REVISION = 2
 
 
+#: the shortest CW phase of a test run [turns]: ~2 turns for the free end to rise plus the
+#: 1-turn hold of the buckling criterion
+MIN_CW_TURNS = 4.0
+#: the most test runs one search may make
+MAX_RUNS = 100
+
+
+def _as_option(name: str) -> str:
+    return name
+
+
+def check_search_options(rtol, cw_turns, ccw_turns, factor, max_runs, guess=None,
+                         bracket=None, option=_as_option) -> None:
+    """The ranges of :class:`CriticalSearch`'s options, before anything runs: one-line
+    :class:`UserInputError` s naming the option as ``option(name)`` (the CLI passes its flag
+    names, the API keeps the keywords)."""
+    def finite(name, v):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise UserInputError(f"{option(name)} must be a finite number, got {v!r}")
+
+    for name, v in (("rtol", rtol), ("cw_turns", cw_turns), ("ccw_turns", ccw_turns),
+                    ("factor", factor)):
+        finite(name, v)
+    if not 0 < rtol < 1:
+        raise UserInputError(f"{option('rtol')} must be in (0, 1), got {rtol}")
+    if not MIN_CW_TURNS <= cw_turns <= 1000:
+        raise UserInputError(
+            f"{option('cw_turns')} must be in [{MIN_CW_TURNS:g}, 1000], got {cw_turns:g}: a test "
+            "run needs ~2 turns for the free end to rise plus the 1-turn hold of the buckling "
+            "criterion, so a shorter K calls slowly buckling runs stable")
+    if not 0.5 <= ccw_turns <= 1000:
+        raise UserInputError(f"{option('ccw_turns')} must be in [0.5, 1000], got {ccw_turns:g}")
+    if not 1.01 <= factor <= 100:
+        raise UserInputError(f"{option('factor')} must be in [1.01, 100], got {factor:g}")
+    if isinstance(max_runs, bool) or not isinstance(max_runs, int) or not 1 <= max_runs <= MAX_RUNS:
+        raise UserInputError(f"{option('max_runs')} must be an integer in [1, {MAX_RUNS}], got "
+                             f"{max_runs!r}")
+    if guess is not None:
+        finite("guess", guess)
+        if not guess > 0:
+            raise UserInputError(f"{option('guess')} must be a Machin number > 0, got {guess:g}")
+    if bracket is not None:
+        lo, hi = bracket
+        finite("bracket", lo)
+        finite("bracket", hi)
+        if not 0 < lo < hi:
+            raise UserInputError(f"{option('bracket')} needs 0 < M_LO < M_HI, got {lo:g} {hi:g}")
+        if max_runs < 2:
+            raise UserInputError(f"{option('bracket')} runs both ends: {option('max_runs')} "
+                                 "must be >= 2")
+
+
 def config_key(cfg, extra: str = "") -> str:
     """16 hex digits of SHA-256 over the config's TOML text, the flagwrap version, the test
     runs' :data:`RUNNER_REVISION` and ``extra`` (whatever else decides the run's result, e.g.

@@ -33,50 +33,18 @@ def add_arguments(p):
 #: the shortest CW phase a test run may have: the free end needs ~1-2 turns to rise to the
 #: threshold near this model's onset (t_c ~ 2 T, docs/critical.md) and must then stay up for
 #: the 1-turn hold, so a shorter K calls every slowly buckling run stable
-MIN_CW_TURNS = 4.0
-MAX_RUNS = 100
-
-
 def _check_options(args) -> None:
     """Every option's range, before anything runs (one-line errors naming the option)."""
-    import math
-
-    from flagwrap.errors import UserInputError
+    from flagwrap.analysis.critical import check_search_options
     from flagwrap.io.outputs import check_output_dir
 
-    def finite(name, v):
-        if not math.isfinite(v):
-            raise UserInputError(f"{name} must be finite, got {v}")
-
-    for name, v in (("--rtol", args.rtol), ("--cw-turns", args.cw_turns),
-                    ("--ccw-turns", args.ccw_turns), ("--factor", args.factor)):
-        finite(name, v)
-    if not 0 < args.rtol < 1:
-        raise UserInputError(f"--rtol must be in (0, 1), got {args.rtol}")
-    if not MIN_CW_TURNS <= args.cw_turns <= 1000:
-        raise UserInputError(
-            f"--cw-turns must be in [{MIN_CW_TURNS:g}, 1000], got {args.cw_turns:g}: a test run needs "
-            "~2 turns for the free end to rise plus the 1-turn hold of the buckling criterion, so a "
-            "shorter K calls slowly buckling runs stable")
-    if not 0.5 <= args.ccw_turns <= 1000:
-        raise UserInputError(f"--ccw-turns must be in [0.5, 1000], got {args.ccw_turns:g}")
-    if not 1.01 <= args.factor <= 100:
-        raise UserInputError(f"--factor must be in [1.01, 100], got {args.factor:g}")
-    if not 1 <= args.max_runs <= MAX_RUNS:
-        raise UserInputError(f"--max-runs must be in [1, {MAX_RUNS}], got {args.max_runs}")
-    if args.guess is not None:
-        finite("--guess", args.guess)
-        if not args.guess > 0:
-            raise UserInputError(f"--guess must be a Machin number > 0, got {args.guess:g}")
-    if args.bracket is not None:
-        lo, hi = args.bracket
-        finite("--bracket", lo)
-        finite("--bracket", hi)
-        if not 0 < lo < hi:
-            raise UserInputError(f"--bracket needs 0 < M_LO < M_HI, got {lo:g} {hi:g}")
-        if args.max_runs < 2:
-            raise UserInputError("--bracket runs both ends: --max-runs must be >= 2")
+    check_search_options(args.rtol, args.cw_turns, args.ccw_turns, args.factor, args.max_runs,
+                         args.guess, args.bracket, option=_flag)
     check_output_dir(args.cache, "--cache")
+
+
+def _flag(name: str) -> str:
+    return "--" + name.replace("_", "-")
 
 
 def _fmt(v, f):

@@ -56,19 +56,10 @@ def check_options(args) -> None:
     """Every option's range before any work (one-line errors naming the option)."""
     from flagwrap.errors import UserInputError
     from flagwrap.io.outputs import check_output_file
+    from flagwrap.stability.threshold import check_continuation_options
 
-    def number(name, v, lo, hi, lo_open=True):
-        if v is None:
-            return
-        if not math.isfinite(v) or (v <= lo if lo_open else v < lo) or v > hi:
-            raise UserInputError(f"{name} must be in {'(' if lo_open else '['}{lo:g}, {hi:g}], got {v:g}")
-
-    number("--m-start", args.m_start, 0.0, 1e7)
-    number("--m-max", args.m_max, 0.0, 1e8)
-    if args.m_max is not None and not args.m_max > args.m_start:
-        raise UserInputError(f"--m-max must be above --m-start ({args.m_start:g}), got {args.m_max:g}")
-    number("--rtol", args.rtol, 0.0, 0.5)
-    number("--factor", args.factor, 1.001, 4.0, lo_open=False)
+    check_continuation_options(args.m_start, args.m_max, args.rtol, args.factor,
+                               option=lambda name: "--" + name.replace("_", "-"))
     if args.mode is not None:
         check_output_file(args.mode, "--mode", {".png", ".pdf", ".svg"})
     if args.vtk is not None:

@@ -255,6 +255,29 @@ def make_frame(config, omega: float):
     return RotatingFrame(RodSystem(config), omega, blob_body=config.body.no_slip)
 
 
+def check_continuation_options(m_start, m_max, rtol, factor, option=lambda name: name) -> None:
+    """The ranges of the continuation's options (:func:`critical_from_config`), before any
+    work: one-line :class:`~flagwrap.errors.UserInputError` s naming the option as
+    ``option(name)`` (the CLI passes its flag names, the API keeps the keywords)."""
+    from flagwrap.errors import UserInputError
+
+    def number(name, v, lo, hi, lo_open=True):
+        if v is None:
+            return
+        if (isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
+                or (v <= lo if lo_open else v < lo) or v > hi):
+            raise UserInputError(f"{option(name)} must be in {'(' if lo_open else '['}{lo:g}, "
+                                 f"{hi:g}], got {v!r}")
+
+    number("m_start", m_start, 0.0, 1e7)
+    number("m_max", m_max, 0.0, 1e8)
+    if m_max is not None and not m_max > m_start:
+        raise UserInputError(f"{option('m_max')} must be above {option('m_start')} "
+                             f"({m_start:g}), got {m_max:g}")
+    number("rtol", rtol, 0.0, 0.5)
+    number("factor", factor, 1.001, 4.0, lo_open=False)
+
+
 def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m_max=None,
                          **kw) -> StabilityResult:
     """:func:`find_critical` for a config: its system, turning at the reference speed in
