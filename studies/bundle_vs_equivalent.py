@@ -2,7 +2,8 @@
 free no-slip cell (docs/bundle.md; issue 28's science).
 
     python studies/bundle_vs_equivalent.py [CONFIG] [--cases bundle2 equiv2 ...]
-                                           [--viscosity MPA_S] [--out out/bundle]
+                                           [--viscosity MPA_S] [--turns CCW CW]
+                                           [--out out/bundle]
 
 CONFIG (default examples/p_putida_bundle.toml) gives the filament, cell, hook, motor and
 protocol. The cases, each a run file ``<out>/<case>.nc`` (resumed from its checkpoint, kept
@@ -28,11 +29,16 @@ import time
 from pathlib import Path
 
 
-def case_config(base, case: str, viscosity=None):
-    """The config of ``case`` (module docstring) from ``base``."""
-    from flagwrap.params import Flagellum
+def case_config(base, case: str, viscosity=None, turns=None):
+    """The config of ``case`` (module docstring) from ``base``; ``turns``: (CCW, CW) motor
+    turns instead of the config's protocol (a CW of 0: CCW only)."""
+    from flagwrap.params import Flagellum, Phase
 
     cfg = base
+    if turns is not None:
+        ccw, cw = turns
+        phases = (Phase("ccw", ccw),) + ((Phase("cw", cw),) if cw > 0 else ())
+        cfg = cfg.replace(motor=dataclasses.replace(cfg.motor, protocol=phases))
     if viscosity is not None:
         cfg = cfg.replace(fluid=dataclasses.replace(cfg.fluid, viscosity=viscosity * 1e-3))
     polar = base.flagella[0].polar_deg if base.flagella else 20.0
@@ -51,6 +57,8 @@ def case_config(base, case: str, viscosity=None):
     else:
         raise SystemExit(f"unknown case {case!r}: single, bundleN, equivN")
     tag = "" if viscosity is None else f"_eta{viscosity:g}"
+    if turns is not None:
+        tag += f"_{turns[0]:g}+{turns[1]:g}"
     return cfg.replace(name=f"{base.name}_{case}{tag}")
 
 
@@ -68,6 +76,8 @@ def run_case(cfg, out: Path) -> dict:
         write_run(traj, path)
         ck.unlink(missing_ok=True)
     ds = read_run(path)
+    if not (ds["omega"].values < 0).any():  # CCW only: the bundle, no buckling verdict
+        return jsonable(_ccw_only(cfg, ds, time.perf_counter() - t0))
     res = analyze_run_file(path)
     row = {"case": cfg.name, "machin": cfg.machin, "status": res["run_status"],
            "buckled": res["buckled"], "state": res["state"],
@@ -84,6 +94,22 @@ def run_case(cfg, out: Path) -> dict:
     return jsonable(row)
 
 
+def _ccw_only(cfg, ds, seconds) -> dict:
+    from flagwrap.io.runfile import filament_slices
+    from flagwrap.observables.bundle import bundle_summary
+    from flagwrap.observables.swimming import body_frame
+
+    x = ds["position"].values
+    if "body_position" in ds.variables:
+        x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
+    b = bundle_summary(ds["turns"].values, x, filament_slices(ds), cfg.filament.helix_radius)
+    return {"case": cfg.name, "machin": cfg.machin, "status": str(ds.attrs["status"]),
+            "n_steps": int(ds.attrs["n_steps"]), "wall_time_s": float(ds.attrs["wall_time_s"]),
+            "bundle": {k: v for k, v in b.items() if not k.endswith("_series")},
+            "separation_by_turn": [float(v) for v in b["separation_series"][::10]],
+            "seconds_here": seconds}
+
+
 def main(argv=None) -> int:
     from flagwrap.io.config import load_config
 
@@ -91,13 +117,16 @@ def main(argv=None) -> int:
     p.add_argument("config", nargs="?", default="examples/p_putida_bundle.toml")
     p.add_argument("--cases", nargs="+", default=["single", "equiv2", "bundle2"])
     p.add_argument("--viscosity", type=float, help="fluid viscosity [mPa s] (default: config's)")
+    p.add_argument("--turns", type=float, nargs=2, metavar=("CCW", "CW"),
+                   help="motor turns of each phase (default: the config's protocol)")
     p.add_argument("--out", default="out/bundle")
     args = p.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     base = load_config(args.config)
     for case in args.cases:
-        print(json.dumps(run_case(case_config(base, case, args.viscosity), out)), flush=True)
+        cfg = case_config(base, case, args.viscosity, args.turns)
+        print(json.dumps(run_case(cfg, out)), flush=True)
     return 0
 
 
