@@ -9,12 +9,10 @@ import numpy as np
 import pytest
 
 from flagwrap.body.cell_body import CappedCylinder
-from flagwrap.errors import UserInputError
-from flagwrap.params import CellBody
 from flagwrap.simulation import Simulation
 from flagwrap.system.parts import Placement, cap_placement
 from flagwrap.system.rod_system import RodSystem, SeveralFilaments
-from conftest import make_config, paper_filament
+from conftest import make_config, paper_filament, tiny_toml
 
 
 def _cfg(hi=False, body=False, n_beads=21, protocol=(("ccw", 0.3), ("cw", 0.2)), **kw):
@@ -172,19 +170,19 @@ def test_placement_turns_the_default_axis_onto_the_given_one():
 
 # ---- the config's [[flagellum]] tables -------------------------------------------------------
 
-TWO = """
-name = "two"
-[filament]
-length = 0.4
-helix_radius = 0.03
-turns = 2
-cross_section_radius = 0.0015
-youngs_modulus = 1.5e6
-n_beads = 21
-[motor]
-machin = 283
-protocol = [{direction = "ccw", turns = 0.2}, {direction = "cw", turns = 0.1}]
-"""
+TWO = tiny_toml(ccw=0.2, cw=0.1, machin=283)
+
+
+def with_tables(tables: str) -> str:
+    """:data:`TWO` and ``tables``; ``[numerics]`` lines in ``tables`` go into TWO's table
+    (TOML defines a table once)."""
+    if "[numerics]\n" not in tables:
+        return TWO + tables
+    head, rest = tables.split("[numerics]\n", 1)
+    lines = rest.split("\n")
+    k = next((i for i, ln in enumerate(lines) if ln.startswith("[")), len(lines))
+    return TWO.replace("[numerics]\n", "[numerics]\n" + "\n".join(lines[:k]) + "\n") + head + \
+        "\n".join(lines[k:])
 
 
 def _load(text):
@@ -272,7 +270,7 @@ def test_bad_flagellum_tables_are_one_line_exit_2(tmp_path, capsys, tables, matc
 
     p = tmp_path / "bad.toml"
     # a top-level key must come before the tables
-    p.write_text(tables + TWO if tables.startswith("flagellum =") else TWO + tables)
+    p.write_text(tables + TWO if tables.startswith("flagellum =") else with_tables(tables))
     out = tmp_path / "out.nc"
     assert main(["run", str(p), "-o", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
@@ -296,8 +294,8 @@ def test_turning_frame_refuses_one_flagellum_off_the_body_axis(tmp_path, capsys)
     from flagwrap.cli.main import main
 
     p = tmp_path / "off.toml"
-    p.write_text(TWO + "[body]\nenabled = false\n[numerics]\nframe = 'rotating'\n"
-                 "[[flagellum]]\nanchor = [0.05, 0.0, 0.0]\naxis = [0, 0, -1]\n")
+    p.write_text(with_tables("[body]\nenabled = false\n[numerics]\nframe = 'rotating'\n"
+                             "[[flagellum]]\nanchor = [0.05, 0.0, 0.0]\naxis = [0, 0, -1]\n"))
     assert main(["run", str(p), "-o", str(tmp_path / "o.nc"), "--quiet"]) == 2
     err = capsys.readouterr().err.strip()
     assert "needs the motor on the body axis" in err and len(err.splitlines()) == 1
