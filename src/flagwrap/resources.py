@@ -9,9 +9,11 @@ inputs to change (``motor.protocol`` turns, ``numerics.save_every``, ``filament.
 Estimates (bytes, float64):
 
 * recorded output: ``n_saves = total_turns / save_every + 2`` frames of
-  ``8 (3 N + 3 (N-1) + (N-1) + 8)`` bytes (positions, directors, twist angles, scalars); held
+  ``8 n_f (3 N + 3 (N-1) + (N-1) + 8)`` bytes for ``n_f`` flagella of ``N`` beads (positions,
+  directors, twist angles, scalars); held
   about three times over while a run file is built (lists, stacked arrays, the SI dataset);
-* dense linear algebra (long-range hydrodynamics, ``ny = 3 N_free + N_bonds + 1 <= 4000``,
+* dense linear algebra (long-range hydrodynamics, ``ny = 3 N_free + N_bonds + n_f <= 4000``
+  over all flagella,
   the crossover of :mod:`flagwrap.integrators.linear`): about five ``ny x ny`` matrices
   (mobility, Jacobian, their product, ``W``, its LU factors);
 * on disk: the run file (one copy of the output) plus a checkpoint of the same size, each
@@ -46,7 +48,7 @@ class Estimate:
     output_memory: float
     linalg_memory: float
     file_bytes: float
-    unknowns: int  # ny: 3 (N - 2) bead coordinates + (N - 2) twists + the motor angle
+    unknowns: int  # ny: per flagellum 3 (N - 2) bead coordinates + (N - 2) twists + its motor angle
 
     @property
     def memory(self) -> float:
@@ -68,15 +70,18 @@ def _dense_solver(linear_solver: str, ny: int) -> bool:
 
 def estimate(config) -> Estimate:
     fil, num = config.filament, config.numerics
+    n_f = max(1, len(config.flagella))  # every flagellum a copy of the filament
     N = int(fil.n_beads)
     turns = total_turns(config)
     n_saves = turns / num.save_every + 2.0
-    frame = 8 * (3 * N + 3 * (N - 1) + (N - 1) + 8)
+    frame = 8 * n_f * (3 * N + 3 * (N - 1) + (N - 1) + 8)
     from flagwrap.joints.clamp import AxialClamp
     from flagwrap.system.layout import DofLayout
 
-    # free coordinates (Estimate.unknowns): the layout RodSystem builds, 4 N - 7 with the clamp
-    ny = DofLayout.clamped_filament(N - AxialClamp.n_beads, N - 1 - AxialClamp.n_edges).size
+    # free coordinates (Estimate.unknowns): the layout RodSystem builds, n_f (4 N - 7) + n_f
+    # - 1 with clamps (each filament's free beads and bonds, one motor angle each)
+    ny = DofLayout.clamped_filament(n_f * (N - AxialClamp.n_beads),
+                                    n_f * (N - 1 - AxialClamp.n_edges), n_motors=n_f).size
     dense = num.hydrodynamics and _dense_solver(num.linear_solver, ny)
     linalg = 5.0 * 8.0 * ny * ny if dense else 200.0 * 8.0 * ny
     return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame, ny)
@@ -135,7 +140,8 @@ def step_seconds(config) -> float:
     num = config.numerics
     if not num.hydrodynamics or num.mobility_backend not in ("direct", "auto"):
         return 0.0
-    return DIRECT_STEP_SECONDS_PER_PAIR * float(config.filament.n_beads) ** 2
+    n = float(config.filament.n_beads) * max(1, len(config.flagella))  # all the beads
+    return DIRECT_STEP_SECONDS_PER_PAIR * n ** 2
 
 
 def check_time(config) -> float:

@@ -67,6 +67,8 @@ class Trajectory:
     #: several flagella: each motor's torque [A/L] then its rate [omega] per frame, (2 n,);
     #: empty for one
     motors: list = field(default_factory=list)
+    #: each filament's (first bead, bead count) in ``x``: the system's parts
+    filaments: list = field(default_factory=list)
     status: str = "running"
     message: str = ""
     n_steps: int = 0
@@ -77,6 +79,12 @@ class Trajectory:
     @property
     def ok(self) -> bool:
         return self.status == "completed"
+
+    def filament_slices(self) -> list:
+        """Each filament's beads in ``x`` (one slice for one filament, or before any frame)."""
+        if self.filaments:
+            return [slice(a, a + n) for a, n in self.filaments]
+        return [slice(0, len(self.x[0]) if self.x else 0)]
 
     def arrays(self) -> dict:
         out = {k: np.asarray(getattr(self, k)) for k in _RECORDS}
@@ -242,7 +250,7 @@ class Simulation:
         """
         s = self.system
         sched = s.schedule
-        traj = Trajectory(self.config)
+        traj = Trajectory(self.config, filaments=[(p.bead0, p.N) for p in s.parts])
         wall0 = 0.0
         if resume is not None:
             from flagwrap.io.checkpoint import Checkpoint, check_compatible, read_checkpoint

@@ -78,6 +78,10 @@ def test_analyze_reports_each_flagellum_and_the_bundle(two_run, tmp_path):
     a, b = res["filaments"]
     assert a["final_height"] == pytest.approx(b["final_height"], abs=1e-6)
     assert a["buckled"] == b["buckled"] and a["state"] == b["state"]
+    # each flagellum's torque is its own motor's: half the total here, by symmetry
+    assert a["torque_peak_reduced"] == pytest.approx(b["torque_peak_reduced"], rel=1e-6)
+    total = read_run(two_run)["motor_torque_reduced"].values
+    assert abs(a["torque_peak_reduced"]) <= 0.5 * np.abs(total).max() * (1 + 1e-6)
     assert not res["bundle"]["bundled"]  # 35 deg apart on the cap: two separate helices
     assert res["bundle"]["crossings"] == 0
     ds = read_run(path)

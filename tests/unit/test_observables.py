@@ -123,7 +123,8 @@ def test_cw_torque_peak_is_the_most_negative_value_after_the_switch():
 def test_free_end_heights_of_flagella_laid_one_after_the_other():
     # two chains of 3 beads: (z(L) - z(0)) / L of each
     x = np.array([[0, 0, 0], [0, 0, -1], [0, 0, -2], [5, 0, 1], [5, 0, 0.5], [5, 0, 0.0]], float)
-    np.testing.assert_allclose(o.free_end_heights(x, 2.0, 2), [-1.0, -0.5])
-    np.testing.assert_allclose(o.free_end_heights(x[None], 2.0, 1), [[0.0]])
-    with pytest.raises(ValueError, match="do not split"):
-        o.free_end_heights(x, 2.0, 4)
+    two = [slice(0, 3), slice(3, 6)]
+    np.testing.assert_allclose(o.free_end_heights(x, 2.0, two), [-1.0, -0.5])
+    np.testing.assert_allclose(o.free_end_heights(x[None], 2.0), [[0.0]])  # one chain of 6
+    with pytest.raises(ValueError, match="do not fit"):
+        o.free_end_heights(x, 2.0, [slice(0, 3), slice(3, 8)])

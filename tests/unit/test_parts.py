@@ -56,6 +56,24 @@ def test_two_filaments_far_apart_without_hi_are_each_the_single_filament():
                                rtol=1e-9)
 
 
+def test_a_run_of_placements_from_python_writes_its_filaments(tmp_path):
+    # no [[flagellum]] tables: the run file's layout comes from the system's parts, so that
+    # the analysis sees two flagella, not one chain from the first anchor to the last tip
+    from flagwrap.analysis.runfile_attrs import analyze_run_file
+    from flagwrap.io.runfile import filament_slices, read_run, write_run
+
+    cfg = _cfg(body=True, protocol=(("ccw", 0.3), ("cw", 0.3)))
+    s, tr = _run(cfg, _tuft(cfg, 2))
+    assert tr.ok and not cfg.flagella
+    path = write_run(tr, tmp_path / "two.nc")
+    ds = read_run(path)
+    N = s.parts[0].N
+    assert filament_slices(ds) == [slice(0, N), slice(N, 2 * N)]
+    np.testing.assert_array_equal(ds["tip_position"].values, ds["position"].values[:, N - 1])
+    res = analyze_run_file(path, write=False)
+    assert len(res["filaments"]) == 2
+
+
 def test_hi_between_two_filaments_is_the_rpy_far_field():
     # the second filament's beads move the first one's through the RPY tensor. Far away that
     # is a multipole series in 1/d: the Stokeslet of the second filament's net force F (the
@@ -300,3 +318,15 @@ def test_turning_frame_refuses_one_flagellum_off_the_body_axis(tmp_path, capsys)
     err = capsys.readouterr().err.strip()
     assert "needs the motor on the body axis" in err and len(err.splitlines()) == 1
     assert "0.05 m off it" in err
+
+
+def test_resource_estimate_counts_every_flagellum():
+    # oracle: the system it estimates (unknowns); memory and step time grow with them
+    from flagwrap.resources import estimate, step_seconds
+
+    one = _load(TWO)
+    three = _load(TWO + "".join(f"[[flagellum]]\npolar_deg = 35\nazimuth_deg = {az}\n"
+                                for az in (0, 120, 240)))
+    assert estimate(three).unknowns == RodSystem(three).ny == 3 * RodSystem(one).ny
+    assert estimate(three).frame_bytes == 3 * estimate(one).frame_bytes
+    assert step_seconds(three) == pytest.approx(9 * step_seconds(one))

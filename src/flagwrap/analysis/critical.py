@@ -117,19 +117,16 @@ def probe_config(cfg, machin: float, ccw_turns: float = 5.0, cw_turns: float = 1
 RUNNER_REVISION = 2
 
 
-#: the shortest CW phase of a test run [turns]: ~2 turns for the free end to rise plus the
-#: 1-turn hold of the buckling criterion
+#: the shortest CW phase a test run may have [turns]: the free end needs ~1-2 turns to rise
+#: to the threshold near this model's onset (t_c ~ 2 T, docs/critical.md) and must then stay
+#: up for the 1-turn hold, so a shorter K calls every slowly buckling run stable
 MIN_CW_TURNS = 4.0
 #: the most test runs one search may make
 MAX_RUNS = 100
 
 
-def _as_option(name: str) -> str:
-    return name
-
-
 def check_search_options(rtol, cw_turns, ccw_turns, factor, max_runs, guess=None,
-                         bracket=None, option=_as_option) -> None:
+                         bracket=None, option=str) -> None:
     """The ranges of :class:`CriticalSearch`'s options, before anything runs: one-line
     :class:`UserInputError` s naming the option as ``option(name)`` (the CLI passes its flag
     names, the API keeps the keywords)."""
@@ -229,7 +226,7 @@ def buckled_long_enough(traj, waiting, stop_after: float) -> str:
     from flagwrap.observables.tip import free_end_heights
 
     turns = np.asarray(traj.t) / TWO_PI
-    heights = free_end_heights(np.asarray(traj.x), 1.0, max(1, len(traj.config.flagella)))
+    heights = free_end_heights(np.asarray(traj.x), 1.0, traj.filament_slices())
     runs = [WaitingTime(**waiting.params()).compute(turns, h, np.asarray(traj.omega))
             for h in heights.T]  # each flagellum; the first to buckle decides
     buckled = [w for w in runs if w.buckled]
@@ -244,8 +241,9 @@ class BuckledStop:
     """Terminating event of the time loop (``Simulation.run(stop=...)``): once buckled
     (:class:`~flagwrap.analysis.buckling.WaitingTime` on the free-end height so far), with the
     crossing at least ``stop_after`` turns back, the run ends. Checked every ``every_turns``
-    from one turn after the first CW phase starts (the schedule ``sched``), as
-    :func:`simulate_until_buckled` checks at its chunk edges.
+    from one turn after the first CW phase starts (the schedule ``sched``); every flagellum's
+    free end is watched, the first to buckle decides (:func:`simulate_until_buckled`'s
+    event).
 
     It does not restart the integrator, so the frames up to the stop are those of the
     uninterrupted run, bit for bit, and it works on every system (it never re-packs a state).

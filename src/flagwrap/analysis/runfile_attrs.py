@@ -38,7 +38,8 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None,
                     filament: int = 0) -> BucklingAnalysis:
     """Run :class:`BucklingAnalysis` on a run dataset (:func:`flagwrap.io.runfile.read_run`),
     on its flagellum ``filament`` (a run of several: :func:`~flagwrap.io.runfile.
-    filament_slices`). The motor torque is the run's (all motors' sum)."""
+    filament_slices`), with its own motor's torque (``motor_torques``; a file without them:
+    the run's, all motors' sum)."""
     from flagwrap.io.runfile import config_of, filament_slices
 
     need = ("position", "turns", "omega")
@@ -53,6 +54,8 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None,
         raise UserInputError("run file has fewer than 2 saved frames")
     a = analysis if analysis is not None else BucklingAnalysis()
     tq = ds["motor_torque_reduced"].values if "motor_torque_reduced" in ds.variables else None
+    if "motor_torques" in ds.variables:  # several flagella: this one's motor
+        tq = ds["motor_torques"].values[:, filament] * R / cfg.filament.bending_modulus
     x = ds["position"].values
     if "body_position" in ds.variables:  # a free swimmer: the filament seen from its body
         from flagwrap.observables.swimming import body_frame

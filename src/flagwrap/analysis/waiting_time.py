@@ -170,8 +170,7 @@ def departure_time(ds, rise: float = 0.05) -> float:
     from flagwrap.io.runfile import filament_slices
     from flagwrap.observables.tip import free_end_heights
 
-    h = free_end_heights(ds["position"].values, float(ds.attrs["length"]),
-                         len(filament_slices(ds)))
+    h = free_end_heights(ds["position"].values, float(ds.attrs["length"]), filament_slices(ds))
     w = WaitingTime(threshold=rise, hold_turns=0.0, onset="crossing")
     times = np.array([w.compute(ds["turns"].values, hk, ds["omega"].values).waiting_time
                       for hk in h.T])  # several flagella: the first to depart

@@ -30,9 +30,6 @@ def add_arguments(p):
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
 
 
-#: the shortest CW phase a test run may have: the free end needs ~1-2 turns to rise to the
-#: threshold near this model's onset (t_c ~ 2 T, docs/critical.md) and must then stay up for
-#: the 1-turn hold, so a shorter K calls every slowly buckling run stable
 def _check_options(args) -> None:
     """Every option's range, before anything runs (one-line errors naming the option)."""
     from flagwrap.analysis.critical import check_search_options

@@ -28,6 +28,7 @@ body_position          (time, xyz)            a free body's reference point (the
 body_orientation       (time, quat)           its unit quaternion (w, x, y, z), body -> lab
 body_velocity          (time, xyz)            its velocity [m/s]
 body_angular_velocity  (time, xyz)            its angular velocity [rad/s]
+tip_position           (time, xyz)            (several flagella: flagellum 0's free end)
 filament_first_bead    (filament)             several flagella: flagellum k's first bead
 filament_n_beads       (filament)             its bead count
 tip_positions          (time, filament, xyz)  each flagellum's free end [m]
@@ -128,16 +129,26 @@ def trajectory_dataset(traj):
                            "rotation sign: positive = CCW seen from the free end",
         },
     )
-    nf = max(1, len(cfg.flagella))
-    if nf > 1:  # several flagella: bead offsets (every flagellum is a copy of [filament])
-        n = x_si.shape[1] // nf
-        first = np.arange(nf) * n
+    # the system's filaments (a trajectory made without the loop: the config's tables)
+    parts = traj.filaments or [(k * (x_si.shape[1] // max(1, len(cfg.flagella))),
+                                x_si.shape[1] // max(1, len(cfg.flagella)))
+                               for k in range(max(1, len(cfg.flagella)))]
+    nf = len(parts)
+    if nf > 1:  # several flagella: where each one's beads are
+        first = np.array([a for a, _ in parts])
+        n = np.array([m for _, m in parts])
         ds["filament_first_bead"] = ("filament", first, {"units": "1",
                                                          "long_name": "first bead of flagellum k"})
-        ds["filament_n_beads"] = ("filament", np.full(nf, n), {"units": "1"})
+        ds["filament_n_beads"] = ("filament", n, {"units": "1"})
         ds["tip_positions"] = (("time", "filament", "xyz"), x_si[:, first + n - 1, :],
                                {"units": "m", "long_name": "free end of flagellum k"})
+        ds["tip_position"] = (("time", "xyz"), x_si[:, first[0] + n[0] - 1, :],
+                              {"units": "m", "long_name": "free end of flagellum 0"})
         ds.attrs["n_flagella"] = nf
+        ds.attrs["conventions"] = (
+            "body axis +z, the body's lowest point at the origin, each flagellum leaving the "
+            "body along its motor axis from its anchor ([[flagellum]] tables); rotation sign: "
+            "positive = CCW seen from the free end")
         if "motors" in a:  # each motor's torque and rate (core -> SI)
             m = a["motors"]
             ds["motor_torques"] = (("time", "filament"), m[:, :nf] * sc.torque,

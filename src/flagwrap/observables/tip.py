@@ -33,21 +33,22 @@ def free_end_height(positions, length) -> np.ndarray:
     return (x[..., -1, 2] - x[..., 0, 2]) / L
 
 
-def free_end_heights(positions, length, n_filaments: int = 1) -> np.ndarray:
-    """:func:`free_end_height` of each of ``n_filaments`` flagella whose beads ``positions``
-    holds one after the other (equal counts: every flagellum a copy of one filament).
+def free_end_heights(positions, length, filaments=None) -> np.ndarray:
+    """:func:`free_end_height` of each flagellum of a run of several, whose beads
+    ``positions`` holds one after the other: ``filaments`` their bead slices (the run file's
+    :func:`~flagwrap.io.runfile.filament_slices`), None for one filament.
 
     Returns
     -------
     ndarray, shape (T, n_filaments) or (n_filaments,)
     """
     x = positions_array(positions)
-    n = int(n_filaments)
-    if n < 1 or x.shape[-2] % n:
-        raise ValueError(f"{x.shape[-2]} beads do not split into {n_filaments} flagella")
-    m = x.shape[-2] // n
-    first = np.arange(n) * m
-    return (x[..., first + m - 1, 2] - x[..., first, 2]) / positive("length", length)
+    sl = [slice(0, x.shape[-2])] if filaments is None else list(filaments)
+    if not sl or any(s.stop > x.shape[-2] or s.stop - s.start < 2 for s in sl):
+        raise ValueError(f"filament slices {sl} do not fit {x.shape[-2]} beads")
+    first = np.array([s.start for s in sl])
+    last = np.array([s.stop - 1 for s in sl])
+    return (x[..., last, 2] - x[..., first, 2]) / positive("length", length)
 
 
 def tip_trajectory(positions, length=None, relative_to_clamp: bool = True) -> np.ndarray:

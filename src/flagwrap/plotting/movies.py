@@ -163,7 +163,7 @@ class MovieFrames:
         from flagwrap.io.runfile import filament_slices
         from flagwrap.observables.tip import free_end_heights
 
-        zt = free_end_heights(self.X, L, len(filament_slices(ds)))  # (T, flagella)
+        zt = free_end_heights(self.X, L, filament_slices(ds))  # (T, flagella)
         tq = ds["motor_torque_reduced"].values
         self.ax_z = fig.add_axes((0.72, 0.52, 0.26, 0.24))
         self.ax_t = fig.add_axes((0.72, 0.12, 0.26, 0.24), sharex=self.ax_z)

@@ -27,7 +27,7 @@ def summary_figure(ds, path):
     from flagwrap.observables.tip import free_end_heights
 
     many = len(filament_slices(ds)) > 1
-    z = free_end_heights(ds["position"].values, L, len(filament_slices(ds)))
+    z = free_end_heights(ds["position"].values, L, filament_slices(ds))
     tq = ds["motor_torque_reduced"].values
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
     for k in range(z.shape[1]):  # one line per flagellum

@@ -32,7 +32,7 @@ def swimming_series(ds) -> dict:
     L = float(ds.attrs["length"])
     return dict(t=t, displacement=disp, t_mid=0.5 * (t[1:] + t[:-1]),
                 motor_hz=np.diff(phi) / dt / (2 * np.pi), body_hz=turn / dt / (2 * np.pi),
-                height=free_end_heights(xb, L, len(filament_slices(ds))))
+                height=free_end_heights(xb, L, filament_slices(ds)))
 
 
 def plot_swimming(ds, path):

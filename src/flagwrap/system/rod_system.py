@@ -3,11 +3,14 @@
 :class:`RodSystem` is built once from a :class:`flagwrap.params.Config` and is then a set of
 pure functions of the state vector ``y``:
 
-* ``y = [x_free (3 n_b), theta_free (n_e), phi]``: positions of the free beads (2..N-1),
-  twist angles of the free bonds (1..N-2) and the motor angle ``phi``;
+* ``y = [x_free (3 n_b), theta_free (n_e), phi (n_f)]``: positions of the free beads (those
+  the joints do not hold: 2..N-1 of one clamped filament), twist angles of the free bonds
+  (1..N-2) and the motor angles, every filament's blocks one after the other
+  (:mod:`flagwrap.system.parts`; one filament is the paper's rig);
 * generalized forces ``G(y) = -dU/dy`` (elastic + contact + gravity), ``G_phi = 0``;
 * equation of motion (paper, Methods, Stokesian dynamics): ``dy/dt = Mob(y) G(y) + omega(t) e_phi``
-  with ``Mob = (1/M) blockdiag(mu_hat_RPY, 1/(8 pi a^3 w_j), 0)``.
+  with ``Mob = (1/M) blockdiag(mu_hat_RPY, 1/(8 pi a^3 w_j), 0)`` (a torque motor's angle
+  follows its own torque balance instead: :mod:`flagwrap.motor.drive`).
 
 The reference frames (parallel transported in time) are carried outside ``y`` in a
 :class:`~flagwrap.elasticity.rod.Frames` "base", updated after each accepted step.
@@ -246,7 +249,7 @@ class RodSystem:
 
     def unpack(self, y):
         """``(x (N, 3), theta (N - n_filaments,), phi)``: every filament's beads and bonds in
-        order; ``phi`` the first motor's angle (the motors turn together)."""
+        order, each joint's beads at its own motor's angle; ``phi`` the first motor's angle."""
         x = np.empty((self.N, 3))
         theta = np.empty(self.N - len(self.parts))
         for k, p in enumerate(self.parts):
@@ -256,6 +259,11 @@ class RodSystem:
         x[self.free_beads] = y[self.sl_x].reshape(-1, 3)
         theta[self.free_bonds] = y[self.sl_th]
         return x, theta, y[self.i_phi]
+
+    def free_positions(self, y) -> np.ndarray:
+        """The free beads' positions (nb, 3), every filament's in order: ``y``'s own, a view
+        (what the mobilities act on; no unpacking of the held beads)."""
+        return y[self.sl_x].reshape(-1, 3)
 
     def bond_lengths(self, x) -> np.ndarray:
         """Every bond's length, (N - n_filaments,), in the order of ``l0``."""
@@ -333,10 +341,9 @@ class RodSystem:
         """``Mob(y) G`` without the motor term; ``single``: to float32 accuracy
         (:meth:`Mobility.apply_single`), for the products inside an iterative solve."""
         out = np.empty_like(G)
-        x, _, _ = self.unpack(y)
         Fx = G[self.sl_x].reshape(-1, 3)
         apply = self.mobility.apply_single if single else self.mobility.apply
-        out[self.sl_x] = apply(x[self.free_beads], Fx).ravel() / self.machin
+        out[self.sl_x] = apply(self.free_positions(y), Fx).ravel() / self.machin
         out[self.sl_th] = G[self.sl_th] / (self.machin * self._rot_drag_free)
         out[self.sl_phi] = 0.0
         return out
@@ -428,8 +435,7 @@ class RodSystem:
                 Mb = self._local_blocks = (
                     self.mobility.near_field_blocks(np.zeros((self.nb, 3)), 0) / self.machin)
             return Mb, self.twist_mobility
-        x, _, _ = self.unpack(y)
-        Mb = self.mobility.near_field_blocks(x[self.free_beads], width)
+        Mb = self.mobility.near_field_blocks(self.free_positions(y), width)
         Mb /= self.machin
         return Mb, self.twist_mobility
 
@@ -441,14 +447,13 @@ class RodSystem:
         ``stage``: the matrix the stage solver's ``W`` is built from, the mobility's
         ``stage_matrix`` where it has one (a W-method keeps its order for any ``W``), else
         the exact one."""
-        x, _, _ = self.unpack(y)
         out = None
         if reuse:
             out = self.__dict__.get("_mxx_buffer")
             if out is None:
                 out = self._mxx_buffer = np.empty((3 * self.nb, 3 * self.nb))
         build = getattr(self.mobility, "stage_matrix", None) if stage else None
-        Mxx = (build or self.mobility.matrix)(x[self.free_beads], out=out)
+        Mxx = (build or self.mobility.matrix)(self.free_positions(y), out=out)
         Mxx /= self.machin
         return Mxx, self.twist_mobility
 
@@ -469,10 +474,9 @@ class RodSystem:
 
     def mobility_matrix(self, y: np.ndarray) -> np.ndarray:
         """Dense ``Mob(y)`` (ny, ny)."""
-        x, _, _ = self.unpack(y)
         Mob = np.zeros((self.ny, self.ny))
         n3 = 3 * self.nb
-        Mob[:n3, :n3] = self.mobility.matrix(x[self.free_beads]) / self.machin
+        Mob[:n3, :n3] = self.mobility.matrix(self.free_positions(y)) / self.machin
         idx = np.arange(n3, n3 + self.ne)
         Mob[idx, idx] = self.twist_mobility
         return Mob
