@@ -96,13 +96,15 @@ def run_case(cfg, out: Path) -> dict:
 
 def _ccw_only(cfg, ds, seconds) -> dict:
     from flagwrap.io.runfile import filament_slices
-    from flagwrap.observables.bundle import bundle_summary
+    from flagwrap.observables.bundle import bundle_summary, last_turn
     from flagwrap.observables.swimming import body_frame
 
     x = ds["position"].values
     if "body_position" in ds.variables:
         x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
-    b = bundle_summary(ds["turns"].values, x, filament_slices(ds), cfg.filament.helix_radius)
+    fil = cfg.filament
+    b = bundle_summary(ds["turns"].values, x, filament_slices(ds), fil.helix_radius,
+                       distal=last_turn(fil.helix_radius, fil.pitch, fil.length))
     return {"case": cfg.name, "machin": cfg.machin, "status": str(ds.attrs["status"]),
             "n_steps": int(ds.attrs["n_steps"]), "wall_time_s": float(ds.attrs["wall_time_s"]),
             "bundle": {k: v for k, v in b.items() if not k.endswith("_series")},

@@ -176,3 +176,20 @@ def test_rebuilt_elastic_energy_of_each_flagellum_adds_up_to_the_simulators(two_
         E.append(sum(ef(x[s], m[s.start - k:s.stop - k - 1], k)[0] for k, s in enumerate(sl)))
     ref = ds["elastic_energy"].values
     np.testing.assert_allclose(E, ref, rtol=1e-8, atol=1e-12 * ref.max())
+
+
+def test_the_last_whole_turn_centres_a_helix_of_any_length():
+    # a 1.85-turn helix (P. putida's coil): its distal half is 0.93 turn, whose centroid is
+    # off the axis by a phase-dependent ~0.1 R; its last whole turn's lies on it
+    from flagwrap.observables.bundle import last_turn
+
+    R, P, turns = 0.1, 0.3, 1.85
+    L = turns * math.hypot(2 * math.pi * R, P)
+    distal = last_turn(R, P, L)
+    assert distal == pytest.approx(1 - 1 / turns)
+    sl = [slice(0, 741), slice(741, 1482)]
+    for phase in np.linspace(0, 2 * math.pi, 5):
+        x = np.concatenate([helix(R, P, turns, 741, phase), helix(R, P, turns, 741, phase + 3.0)])
+        assert bundle_separation(x[None], sl, R, distal)[0] < 1e-2
+    half = bundle_separation(x[None], sl, R, 0.5)[0]
+    assert half > 5e-2  # the half-filament centroid is off the axis

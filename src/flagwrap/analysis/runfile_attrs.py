@@ -186,7 +186,7 @@ def _analyze_flagella(ds, analysis, slices, path, write: bool) -> dict:
     import copy
 
     from flagwrap.io.runfile import config_of, write_dataset_atomic
-    from flagwrap.observables.bundle import bundle_summary
+    from flagwrap.observables.bundle import bundle_summary, last_turn
 
     base = analysis if analysis is not None else BucklingAnalysis()
     each = [analyze_dataset(ds, copy.deepcopy(base), k) for k in range(len(slices))]
@@ -196,8 +196,10 @@ def _analyze_flagella(ds, analysis, slices, path, write: bool) -> dict:
 
         x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
     cfg = config_of(ds)
-    bundle = bundle_summary(ds["turns"].values, x, slices, cfg.filament.helix_radius,
-                            final_turns=base.final.final_turns)
+    fil = cfg.filament
+    bundle = bundle_summary(ds["turns"].values, x, slices, fil.helix_radius,
+                            final_turns=base.final.final_turns,
+                            distal=last_turn(fil.helix_radius, fil.pitch, fil.length))
     from flagwrap.interactions.self_contact import count_crossings
 
     # segments passing through each other between saved frames, within and between flagella

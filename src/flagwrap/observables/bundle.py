@@ -3,7 +3,8 @@
 A bundle's helices turn about one common axis; flagella that have not bundled turn about
 axes of their own. Over a whole number of helical turns the centroid of a helix lies on its
 axis, so the centroids of the filaments' distal parts (arclength ``s >= distal L``, away from
-the anchors, which sit apart on the body) measure how far apart their axes are:
+the anchors, which sit apart on the body; :func:`last_turn` makes it the last whole helical
+turn) measure how far apart their axes are:
 
     separation(t) = mean over pairs k < l of |c_k(t) - c_l(t)| / R,
 
@@ -17,9 +18,20 @@ filament 0's, wrapped to (-pi, pi]: a locked bundle keeps it constant.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from flagwrap.observables._util import positions_array, positive
+
+
+def last_turn(helix_radius: float, pitch: float, length: float) -> float:
+    """The ``distal`` fraction that makes a filament's distal part its last whole helical
+    turn: ``max(0, 1 - c / L)`` for rest radius ``R``, pitch ``P`` and length ``L``, with
+    ``c = sqrt((2 pi R)^2 + P^2)`` the contour of one turn (the whole filament when it has
+    less than one turn)."""
+    per_turn = math.hypot(2.0 * math.pi * helix_radius, pitch)
+    return max(0.0, 1.0 - per_turn / length)
 
 
 def _centroids(x, slices, distal, proximal: bool = False):
