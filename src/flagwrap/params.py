@@ -282,8 +282,9 @@ class CellBody:
     (Cholesky once, O(n^2) memory), "krylov" (conjugate gradients, O(n) memory) or "auto"
     (direct up to 1500 blobs; :mod:`flagwrap.body.solver`). ``shape``: "capped-cylinder" (the
     paper's, default), "spheroid" (equatorial radius ``R_cell``, total length ``R_cell +
-    cylinder_length`` along the axis, lowest point at the clamp) or "sphere" (radius
-    ``R_cell``); every shape has its contact law, its blobs and its drawings.
+    cylinder_length`` along the axis, lowest point at the clamp), "sphere" (radius
+    ``R_cell``) or a shape registered from Python (:mod:`flagwrap.body.shapes`: a class that
+    owns its distance, blobs, mesh and pole cap).
     """
 
     radius: float | None = None
@@ -298,6 +299,7 @@ class CellBody:
     shape: str = "capped-cylinder"
 
     DEFAULT_RADIUS_RATIO = 0.6
+    #: the built-in shapes (:func:`flagwrap.body.shapes.shape_names` lists those registered)
     SHAPES = ("capped-cylinder", "sphere", "spheroid")
     SURFACES = ("transparent", "no-slip")
     MOTIONS = ("fixed", "free")
@@ -323,8 +325,12 @@ class CellBody:
             _positive("body.cylinder_length", self.cylinder_length, "m")
         if not isinstance(self.enabled, bool):
             raise UserInputError(f"body.enabled must be true or false, got {self.enabled!r}")
-        if self.shape not in self.SHAPES:
-            raise UserInputError(f"body.shape must be one of {', '.join(self.SHAPES)}, got {self.shape!r}")
+        from flagwrap.body.shapes import shape_names
+
+        if self.shape not in shape_names():
+            raise UserInputError(f"body.shape must be one of {', '.join(shape_names())}, got "
+                                 f"{self.shape!r} (a shape of your own: "
+                                 "flagwrap.body.shapes.register_shape)")
         if self.shape == "sphere" and self.cylinder_length is not None:
             raise UserInputError("body.cylinder_length does not apply to body.shape = 'sphere' "
                                  "(its length is its diameter)")

@@ -100,3 +100,28 @@ def wca_energy_grad(x, first, Rc, H, sigma, eps, c2, grad, dist, shape=0):
         grad[i, 1] += dU * gy
         grad[i, 2] += dU * gz
     return E
+
+
+@nb.njit(cache=True)
+def distances(x, Rc, H, shape, d, n):
+    """Each point's signed distance ``d`` (n,) to the body ``shape`` (:func:`body_distance`)
+    and its gradient ``n`` (n, 3)."""
+    for i in range(x.shape[0]):
+        d[i], n[i, 0], n[i, 1], n[i, 2] = body_distance(x[i, 0], x[i, 1], x[i, 2], Rc, H, shape)
+
+
+@nb.njit(cache=True)
+def wca_law(d, sigma, eps, c2, energy, dU, d2U):
+    """The body contact's law of :func:`wca_energy_grad` on given distances: ``energy``,
+    ``dU/dd`` and ``d^2U/dd^2`` (zero beyond the cut-off and for ``d <= 0``)."""
+    cut = 2.0 ** (1.0 / 6.0) * sigma
+    k2 = c2 * 72.0 * eps / (cut * cut)
+    for i in range(d.shape[0]):
+        di = d[i]
+        if di >= cut or di <= 0.0:
+            energy[i] = dU[i] = d2U[i] = 0.0
+            continue
+        s6 = (sigma / di) ** 6
+        energy[i] = 4.0 * eps * (s6 * s6 - s6) + eps - 0.5 * k2 * (di - cut) ** 2
+        dU[i] = 4.0 * eps * (-12.0 * s6 * s6 + 6.0 * s6) / di - k2 * (di - cut)
+        d2U[i] = 4.0 * eps * (156.0 * s6 * s6 - 42.0 * s6) / (di * di) - k2

@@ -250,17 +250,13 @@ def spheroid_ring_blobs(equatorial: float, axial: float, spacing: float) -> np.n
 
 def cell_body_blobs(config) -> tuple[np.ndarray, np.ndarray]:
     """The blobs of ``config``'s no-slip cell body in core units (lengths in ``L``): centres
-    (n, 3) inset by ``BLOB_INSET`` blob radii under the surface of
-    :class:`~flagwrap.body.cell_body.CappedCylinder` (its shape; lowest point at the origin)
-    and their radii (n,)."""
+    (n, 3) inset by ``BLOB_INSET`` blob radii under the surface of its shape
+    (:meth:`flagwrap.body.shapes.BodyShape.blob_shell`; lowest point at the origin) and their
+    radii (n,)."""
+    from flagwrap.body.shapes import config_shape
+
     b, fil = config.body, config.filament
     R, L = fil.helix_radius, fil.length
     ab = b.resolved_blob_radius(R) / L
-    Rc, H, sp = b.resolved_radius(R) / L, b.resolved_length(R) / L, b.resolved_blob_spacing(R) / L
-    if b.shape == "capped-cylinder":
-        blobs = inset_capped_cylinder_blobs(Rc, H, sp, ab)
-    else:  # a spheroid of semi-axes Rc and (Rc + H)/2; the inset shell keeps its centre
-        d = BLOB_INSET * ab
-        c = 0.5 * (Rc + H)
-        blobs = spheroid_ring_blobs(Rc - d, c - d, sp) + np.array([0.0, 0.0, d])
+    blobs = config_shape(config).blob_shell(b.resolved_blob_spacing(R) / L, ab)
     return blobs, np.full(len(blobs), ab)

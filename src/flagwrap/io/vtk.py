@@ -315,14 +315,12 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
         entries.append((float(tvals[i]), 0, name))
     scene = scene_of(ds)
     poses = body_poses(ds)
-    if scene.has_body and poses is None:
-        v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around,
-                            shape=scene.body_shape)
+    v, f = (body_surface(scene.body_radius, scene.body_length, n_around=n_around,
+                         shape=scene.body_shape) if scene.has_body else (None, None))
+    if v is not None and poses is None:
         _write(d / "body.vtp", polydata_xml(v, polys=f))
         entries += [(float(tvals[i]), 1, "body.vtp") for i in idx]
-    elif scene.has_body:  # a free swimmer: the body where it is, frame by frame
-        v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around,
-                            shape=scene.body_shape)
+    elif v is not None:  # a free swimmer: the body where it is, frame by frame
         for i in idx:
             name = f"body_{i:0{width}d}.vtp"
             _write(d / name, polydata_xml(v @ poses[1][i].T + poses[0][i], polys=f))

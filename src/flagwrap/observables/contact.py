@@ -1,9 +1,9 @@
 """Distance of the beads from the cell body and "beside the body" masks.
 
-The body is the simulator's capped cylinder (:class:`flagwrap.body.cell_body.CappedCylinder`):
-a hemisphere of radius ``R_cell`` centred at ``(0, 0, R_cell)`` (its lowest point is the
-clamp at the origin) and a cylinder of the same radius up to ``z = R_cell + H``. Distances are
-from bead centres to the surface, negative inside, in the unit of the positions.
+The body is the simulator's (:mod:`flagwrap.body.shapes`; the paper's capped cylinder by
+default: a hemisphere of radius ``R_cell`` centred at ``(0, 0, R_cell)``, its lowest point the
+clamp at the origin, and a cylinder of the same radius up to ``z = R_cell + H``). Distances
+are from bead centres to the surface, negative inside, in the unit of the positions.
 """
 
 from __future__ import annotations
@@ -23,23 +23,25 @@ def body_distance(positions, body_radius, body_length, shape="capped-cylinder") 
         bead centres [length].
     body_radius, body_length : float
         ``R_cell`` and the cylinder length ``H`` [length].
-    shape : the body's shape (:class:`flagwrap.params.CellBody`)
+    shape : str or BodyShape
+        the body's shape: a name (``body.shape``: :func:`flagwrap.body.shapes.make_shape`
+        builds it at ``body_radius``, ``body_length``) or a shape object of this unit.
 
     Returns
     -------
     ndarray, shape (..., N)
         [length], negative inside the body. Same law as the simulator's contact kernel.
     """
-    from flagwrap.body.cell_body import CappedCylinder
+    from flagwrap.body.shapes import make_shape
 
     x = positions_array(positions, min_beads=1)
-    Rc = positive("body_radius", body_radius)
-    H = float(body_length)
-    if not H >= 0:
-        raise UserInputError(f"body_length must be >= 0, got {body_length!r}")
-    body = CappedCylinder(Rc, H, cutoff=1.0, strength=0.0, shape=shape)
-    flat = np.ascontiguousarray(x.reshape(-1, 3))
-    return body.distance(flat).reshape(x.shape[:-1])
+    if isinstance(shape, str):
+        Rc = positive("body_radius", body_radius)
+        H = float(body_length)
+        if not H >= 0:
+            raise UserInputError(f"body_length must be >= 0, got {body_length!r}")
+        shape = make_shape(shape, Rc, H)
+    return shape.distance(x)
 
 
 def near_body_mask(positions, body_radius, body_length, max_distance, z_min=0.0,

@@ -230,63 +230,28 @@ def tube_faces(x: np.ndarray, radius: float, sides: int = 12, subdivide: int = 3
 
 
 def body_surface(radius: float, length: float, n_around: int = 48, n_cap: int = 12,
-                 n_cyl: int = 6, shape: str = "capped-cylinder"):
-    """Closed triangle mesh of the cell body (surface of revolution about +z).
-
-    Profile: hemisphere of radius ``radius`` centred at ``(0, 0, radius)`` from its bottom
-    pole at the origin to its equator, the cylinder up to ``z = radius + length``, and the
-    flat top disc. ``shape = "spheroid"`` or ``"sphere"``: the spheroid of equatorial radius
-    ``radius`` from the origin to ``z = radius + length`` (``2 (n_cap + n_cyl)`` rings).
+                 n_cyl: int = 6, shape="capped-cylinder"):
+    """Closed triangle mesh of the cell body (:meth:`flagwrap.body.shapes.BodyShape.
+    surface_mesh`; ``n_cap + n_cyl`` divisions along its profile).
 
     Parameters
     ----------
     radius, length : ``R_cell`` and cylinder length ``H`` [m]
     n_around, n_cap, n_cyl : divisions in azimuth, in the cap's polar angle, along the cylinder
+    shape : a ``body.shape`` name, or a shape object in metres
 
     Returns
     -------
     vertices : (V, 3) [m]
-    triangles : (F, 3) int, counter-clockwise seen from outside (outward normals)
+    triangles : (F, 3) int, counter-clockwise seen from outside (outward normals); ``None``
+        for a shape without a mesh
     """
-    R = float(radius)
-    if shape in ("spheroid", "sphere"):
-        c = 0.5 * (R + length)
-        a = np.linspace(0.0, np.pi, 2 * (n_cap + n_cyl) + 1)
-        prof_r, prof_z = R * np.sin(a), c * (1.0 - np.cos(a))
-        prof_r[-1] = 0.0
-    else:
-        a = np.linspace(0.0, np.pi / 2, n_cap + 1)  # polar angle from the bottom pole
-        prof_r = list(R * np.sin(a))
-        prof_z = list(R - R * np.cos(a))
-        zc = np.linspace(R, R + length, n_cyl + 1)[1:]
-        prof_r += [R] * len(zc)
-        prof_z += list(zc)
-        # profile starts at the bottom pole (r = 0) and ends at the top centre (r = 0)
-        prof_r.append(0.0)
-        prof_z.append(R + length)
-        prof_r, prof_z = np.asarray(prof_r), np.asarray(prof_z)
-    phi = 2 * np.pi * np.arange(n_around) / n_around
-    verts = [np.array([[0.0, 0.0, prof_z[0]]])]
-    index = [np.zeros(n_around, dtype=int)]
-    nxt = 1
-    for r, z in zip(prof_r[1:-1], prof_z[1:-1]):
-        verts.append(np.column_stack([r * np.cos(phi), r * np.sin(phi), np.full(n_around, z)]))
-        index.append(nxt + np.arange(n_around))
-        nxt += n_around
-    verts.append(np.array([[0.0, 0.0, prof_z[-1]]]))
-    index.append(np.full(n_around, nxt))
-    k = np.arange(n_around)
-    k1 = (k + 1) % n_around
-    tris = []
-    for j in range(len(index) - 1):
-        lo, hi = index[j], index[j + 1]
-        # going up the profile the outward normal points out and down, then out, then up:
-        # (lo_k, lo_k1, hi_k1) and (lo_k, hi_k1, hi_k) are counter-clockwise seen from outside
-        if j > 0:
-            tris.append(np.column_stack([lo[k], lo[k1], hi[k1]]))
-        if j < len(index) - 2:
-            tris.append(np.column_stack([lo[k], hi[k1], hi[k]]))
-    return np.concatenate(verts), np.concatenate(tris)
+    from flagwrap.body.shapes import make_shape
+
+    if isinstance(shape, str):
+        shape = make_shape(shape, radius, length)
+    mesh = shape.surface_mesh(n_around, n_cap + n_cyl)
+    return (None, None) if mesh is None else mesh
 
 
 def _face_normals(poly: np.ndarray) -> np.ndarray:
@@ -336,9 +301,9 @@ class Renderer:
         self.tube_rgb = np.asarray(tube_rgb, float)
         self.body_rgb = np.asarray(body_rgb, float)
         self.body_alpha = float(body_alpha)
-        if scene.has_body:
-            v, f = body_surface(scene.body_radius, scene.body_length, n_around=n_around,
-                                shape=scene.body_shape)
+        v, f = (body_surface(scene.body_radius, scene.body_length, n_around=n_around,
+                             shape=scene.body_shape) if scene.has_body else (None, None))
+        if v is not None:  # a shape without a mesh is not drawn
             self._body = v[f]
             self._body_n = _face_normals(self._body)
         else:

@@ -18,7 +18,7 @@ meet through the mobility (one over all free beads) and the interactions (contac
 
 :class:`Placement` puts the default shape (built at the origin, motor axis ``-z``, the body
 above) at an anchor on the body surface with its motor axis along the surface normal
-(:func:`cap_placement` on the capped cylinder's pole cap).
+(on the body shape's pole cap: :meth:`flagwrap.body.shapes.BodyShape.pole_cap`).
 """
 
 from __future__ import annotations
@@ -91,9 +91,9 @@ def cap_placement(cap_radius: float, polar: float, azimuth: float, spin: float |
     pole and ``azimuth`` [rad] about the body axis, motor axis along the outward normal.
     ``spin`` (default ``azimuth``) turns the shape about its own axis, so that anchors spread
     by azimuth carry copies of one shape turned about the body axis (a symmetric tuft)."""
-    n = np.array([math.sin(polar) * math.cos(azimuth), math.sin(polar) * math.sin(azimuth),
-                  -math.cos(polar)])
-    origin = np.array([0.0, 0.0, cap_radius]) + cap_radius * n
+    from flagwrap.body.shapes import CappedCylinderShape
+
+    origin, n = CappedCylinderShape(cap_radius, 0.0).pole_cap(polar, azimuth)
     return Placement.from_axis(origin, n, azimuth if spin is None else spin)
 
 
@@ -269,10 +269,12 @@ def placements_from_config(config) -> list | None:
     out = []
     for f in config.flagella:
         spin = None if f.spin_deg is None else math.radians(f.spin_deg)
-        if f.anchor is None:
-            Rc = config.body.resolved_radius(config.filament.helix_radius) / L
-            out.append(cap_placement(Rc, math.radians(f.polar_deg or 0.0),
-                                     math.radians(f.azimuth_deg or 0.0), spin))
+        if f.anchor is None:  # on the shape's pole cap
+            from flagwrap.body.shapes import config_shape
+
+            az = math.radians(f.azimuth_deg or 0.0)
+            origin, n = config_shape(config).pole_cap(math.radians(f.polar_deg or 0.0), az)
+            out.append(Placement.from_axis(origin, n, az if spin is None else spin))
         else:
             out.append(Placement.from_axis(np.asarray(f.anchor, float) / L, f.axis, spin or 0.0))
     return out
@@ -288,29 +290,33 @@ def check_flagella(config) -> None:
     from flagwrap.geometry.helix import filament_positions
     from flagwrap.observables.contact import body_distance
 
+    from flagwrap.body.shapes import config_shape
+
     fil, body = config.filament, config.body
     L, a = fil.length, fil.cross_section_radius
-    Rc = body.resolved_radius(fil.helix_radius)
-    H = body.resolved_length(fil.helix_radius)
+    shape = config_shape(config, unit=1.0) if body.enabled else None  # metres
     for k, f in enumerate(config.flagella):
         where = f"flagellum[{k}]"
-        if f.anchor is None and not (body.enabled and body.shape in ("capped-cylinder", "sphere")):
-            raise UserInputError(
-                f"{where}.polar_deg places the flagellum on a spherical pole cap: it needs "
-                "body.enabled = true and body.shape = 'capped-cylinder' or 'sphere' (this body: "
-                f"{body.shape if body.enabled else 'none'}); give {where}.anchor and axis instead")
-        if f.anchor is not None and body.enabled:
+        if f.anchor is None:
+            if shape is None:
+                raise UserInputError(
+                    f"{where}.polar_deg places the flagellum on the body's pole cap: it needs "
+                    f"body.enabled = true; give {where}.anchor and axis instead")
+            try:
+                shape.pole_cap(0.0, 0.0)
+            except UserInputError:
+                raise UserInputError(
+                    f"{where}.polar_deg places the flagellum on a spherical pole cap, which "
+                    f"body.shape = {body.shape!r} does not have; give {where}.anchor and axis "
+                    "instead") from None
+        if f.anchor is not None and shape is not None:
             p = np.asarray(f.anchor, float)
-            d = float(body_distance(p[None], Rc, H, body.shape)[0])
+            d = float(shape.distance(p))
             if abs(d) > 0.1 * a:
                 raise UserInputError(
                     f"{where}.anchor = {list(f.anchor)} m is {d:.3g} m from the body surface; it "
                     f"must lie on it (within 0.1 a = {0.1 * a:.3g} m)")
-            h = 1e-3 * Rc
-            n = np.array([(body_distance((p + h * e)[None], Rc, H, body.shape)[0]
-                           - body_distance((p - h * e)[None], Rc, H, body.shape)[0]) / (2 * h)
-                          for e in np.eye(3)])
-            if not float(n @ np.asarray(f.axis, float)) > 0.0:
+            if not float(shape.normal(p) @ np.asarray(f.axis, float)) > 0.0:
                 raise UserInputError(f"{where}.axis = {list(f.axis)} points into the body; the "
                                      "motor axis must point out of it")
     if len(config.flagella) > 1 and config.numerics.frame != "lab":

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flagwrap.system import kernels as SK
-from flagwrap.body.cell_body import CappedCylinder, NoBody, body_mobility
+from flagwrap.body.cell_body import BodyContact, NoBody, ShapeContact, body_mobility
 from flagwrap.elasticity.rod import Frames
 from flagwrap.hydrodynamics.mobility import make_mobility
 from flagwrap.motor.drive import make_drive
@@ -120,23 +120,31 @@ class RodSystem:
         self.mobility = mobility or body_mobility(config, self.radius) or make_mobility(
             num.hydrodynamics, self.radius, backend=num.mobility_backend,
             n=self.N, threads=num.threads, fmm_eps=num.mobility_tol)
-        # cell body
+        # cell body: its shape (flagwrap.body.shapes) and contact
         if config.body.enabled:
-            R = fil.helix_radius
-            self.body = body or CappedCylinder(
-                radius=config.body.resolved_radius(R) / L,
-                length=config.body.resolved_length(R) / L,
+            from flagwrap.body.shapes import config_shape
+
+            self.body = body or BodyContact(
+                config_shape(config),
                 cutoff=fil.cross_section_radius * (1.0 + config.contact.range) / L,
                 strength=config.contact.strength / b,
                 first_bead=parts[0].nc,
                 potential=config.contact.potential,
-                shape=config.body.shape,
             )
         else:
             self.body = body or NoBody()
-        self._has_body = not isinstance(self.body, NoBody)
+        # the fused kernel evaluates the shapes it knows; any other is an interaction
+        self._has_body = bool(self.body.fused)
+        self._shape_contact = None
+        if not self.body.fused and self.body.body_shape is not None:
+            active = np.ones(self.N, bool)
+            for p in parts:
+                active[p.bead0:p.bead0 + p.nc] = False
+            self._shape_contact = ShapeContact(self.body, active)
         self.schedule = Schedule(config.motor.protocol)
         self.interactions = self._config_interactions() + list(interactions)
+        if self._shape_contact is not None:
+            self.interactions.insert(0, self._shape_contact)
 
     def _assemble(self, config) -> None:
         """Offsets of every part's beads, bonds and unknowns; the system's layout and its
@@ -307,6 +315,11 @@ class RodSystem:
             gthe = np.zeros(len(theta))
             for it in self.interactions:
                 Ei += it.energy_grad(x, theta, gxe, gthe)
+            sc = self._shape_contact
+            if sc is not None:  # the body's contact, reported as the fused kernel's would be
+                Ei -= sc.energy
+                Ec += sc.energy
+                dist = sc.distance
             G[self.sl_x] -= gxe[self.free_beads].ravel()
             G[self.sl_th] -= gthe[self.free_bonds]
             gx += gxe

@@ -4,9 +4,9 @@ The lab-frame system (:mod:`flagwrap.system.rod_system`) is
 ``dx/dt = Mob(x) G_x``, ``dtheta_j/dt = G_theta_j / zeta_j`` with the motor angle ``phi``
 turning the clamp, ``dphi/dt = omega``. Write every vector in the frame that turns with the
 clamp about the motor axis ``a`` (``x = R(phi) x'``). The energy is invariant under rotations.
-The RPY mobility is covariant, ``Mob(R x) = R Mob(x) R^T``. The cell body is a capped cylinder
-on the axis, and gravity is parallel to it. So in that frame the clamp stands still and the
-equations are autonomous:
+The RPY mobility is covariant, ``Mob(R x) = R Mob(x) R^T``. The cell body is a body of
+revolution about the axis (its shape's ``axisymmetric``), and gravity is parallel to it. So
+in that frame the clamp stands still and the equations are autonomous:
 
     dx'/dt      = Mob(x') G_x(x', theta')  - omega a x x'
     dtheta'_j/dt = G_theta_j / zeta_j       - omega (a . t'_j)
@@ -76,13 +76,18 @@ def check_rotating_frame(system, blob_body: bool = False) -> None:
     a = np.asarray(axis, float)
     ez = np.array([0.0, 0.0, 1.0])
     if np.linalg.norm(np.cross(a, ez)) > 1e-12:
-        # the capped cylinder and gravity are along z: the motor axis must be too
+        # the body's axis and gravity are along z: the motor axis must be too
         raise UserInputError("the rotating frame needs the motor axis along the body axis z")
     o = np.asarray(getattr(joint, "origin", np.zeros(3)), float)
     if math.hypot(o[0], o[1]) > 1e-12:
         raise UserInputError(
             "the rotating frame needs the motor on the body axis; this flagellum's anchor is "
             f"{math.hypot(o[0], o[1]):.3g} L off it ([[flagellum]] anchor)")
+    shape = getattr(getattr(system, "body", None), "body_shape", None)
+    if shape is not None and not shape.axisymmetric:
+        raise UserInputError(
+            f"the rotating frame needs a body symmetric about the motor axis; body.shape = "
+            f"{shape.name!r} is not (its class says axisymmetric = False): use the lab frame")
     g = np.asarray(system.gravity)
     if np.any(np.abs(g[:, :2]) > 0.0):
         raise UserInputError("the rotating frame needs gravity along the motor axis")
