@@ -481,8 +481,10 @@ class RunInterrupted(KeyboardInterrupt):
 
 
 def make_system(config):
-    """The config's system: a :class:`RodSystem`, stepped in the turning frame when
-    ``numerics.frame = "rotating"`` (:class:`flagwrap.system.rotating.RotatingSystem`)."""
+    """The config's system, a :class:`RodSystem`: transformed to the turning frame when
+    ``numerics.frame = "rotating"`` (:class:`flagwrap.system.rotating.RotatingSystem`), or
+    given a free body (``body.motion = "free"``: :class:`flagwrap.system.swimmer.
+    SwimmerSystem`); either is a ``RodSystem`` over the same parts, not a wrapper."""
     if config.body.free:
         from flagwrap.system.swimmer import make_swimmer
 

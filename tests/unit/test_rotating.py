@@ -139,3 +139,22 @@ def test_buckling_run_in_the_turning_frame_has_the_lab_runs_onset_and_torque(tmp
     assert a["buckled"] and b["buckled"]
     assert abs(a["waiting_time_turns"] - b["waiting_time_turns"]) <= 0.05 + 1e-9
     assert b["torque_peak_reduced"] == pytest.approx(a["torque_peak_reduced"], rel=5e-2)
+
+
+def test_the_turning_frame_is_the_system_transformed_not_a_wrapper():
+    # the same RodSystem data under this frame's equations: nothing forwarded, every method
+    # of the protocol its own; pack takes lab positions and record_view gives them back
+    lab = RodSystem(small(n_beads=21))
+    s = RotatingSystem(lab)
+    assert isinstance(s, RodSystem) and "__getattr__" not in vars(RotatingSystem)
+    assert s.parts is lab.parts and s.layout is lab.layout
+    rng = np.random.default_rng(5)
+    x, theta, _ = lab.unpack(lab.initial_y())
+    x[lab.free_beads] += 1e-3 * rng.standard_normal((lab.nb, 3))
+    phi = 1.234
+    x[:lab.nc] = lab.joint.positions(phi)  # the clamp where the motor holds it in the lab
+    y = s.pack(x, theta, phi)
+    info = s.record_view(y, s.forces(y, s.frames0))
+    np.testing.assert_allclose(info.x, x, atol=1e-14)
+    # in the frame the clamp is where the lab clamp is at phi = 0
+    np.testing.assert_allclose(s.unpack(y)[0][:lab.nc], lab.joint.positions(0.0), atol=1e-15)

@@ -114,7 +114,7 @@ def test_mobility_matrix_is_the_map_and_symmetric_positive(swimmer, rng):
     y, info = perturbed_state(s, rng)
     A = s.mobility_matrix(y)
     f = s.apply_mobility(y, info.G)
-    assert np.allclose(A @ info.G, f[:s.n_in], rtol=0, atol=1e-12 * np.abs(f).max())
+    assert np.allclose(A @ info.G[:s.n_in], f[:s.n_in], rtol=0, atol=1e-12 * np.abs(f).max())
     assert np.abs(A - A.T).max() < 1e-12 * np.abs(A).max()
     ev = np.linalg.eigvalsh(0.5 * (A + A.T))
     assert ev[0] > -1e-12 * ev[-1]  # positive semidefinite (the motor angle's row is zero)
@@ -150,8 +150,8 @@ def test_swimmer_w_leaves_the_screening_out_while_a_bead_touches_the_body(rng):
     y, info = perturbed_state(s, rng)
     s.make_w("dense", y, s.frames0, info.G, 0.05)
     assert s._lagged.computed == 1
-    k = s.inner.sl_x.start + 3 * 5
-    y[k:k + 3] = [0.125 + 1.5 * s.inner.radius, 0.0, 0.2]
+    k = s.sl_x.start + 3 * 5
+    y[k:k + 3] = [0.125 + 1.5 * s.radius, 0.0, 0.2]
     info = s.forces(y, s.frames0)
     assert info.contact_energy > 0
     fresh = make_swimmer(swimmer_config())
@@ -441,10 +441,30 @@ def test_swimmer_w_from_triplets_is_the_dense_product(swimmer, rng):
     s = swimmer
     y, info = perturbed_state(s, rng)
     n = s.n_in
-    rows, cols, vals = s.inner.force_jacobian_coo(y[:n], s.frames0, info.G[:n])
+    rows, cols, vals = s.force_jacobian_coo(y[:n], s.frames0, info.G[:n])
     A = s.mobility_matrix(y, screening=False)
     WT = np.empty((n, n))
     w_transpose_dense(rows, cols, vals, A, np.empty(0), 0.3, WT)
     J = sp.coo_matrix((vals, (rows, cols)), shape=(n, n)).toarray()
     W = np.eye(n) - 0.3 * A @ J
     assert np.abs(WT.T - W).max() < 1e-12 * np.abs(W).max()
+
+
+def test_the_swimmer_is_the_system_transformed_with_a_pose_block(rng):
+    # a RodSystem over the same parts with the free body's pose after the filaments'
+    # unknowns: pack takes the pose, pose() gives it back, the forces' pose rows are 0
+    from flagwrap.system.rod_system import RodSystem
+
+    s = make_swimmer(swimmer_config())
+    assert isinstance(s, RodSystem) and "__getattr__" not in vars(SwimmerSystem)
+    assert s.ny == s.n_rod + 7 and s.n_in == s.n_rod
+    x, theta, phi = s.unpack(s.initial_y())
+    q = rng.standard_normal(4)
+    q /= np.linalg.norm(q)
+    y = s.pack(x, theta, phi, X=(1.0, 2.0, 3.0), q=q)
+    X, R = s.pose(y)
+    np.testing.assert_array_equal(X, [1.0, 2.0, 3.0])
+    np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-14)
+    assert np.array_equal(y[:s.n_rod], s.initial_y()[:s.n_rod])
+    G = s.forces(y, s.frames0).G
+    assert G.shape == (s.ny,) and not G[s.n_rod:].any()

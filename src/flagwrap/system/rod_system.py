@@ -159,6 +159,10 @@ class RodSystem:
         motor = "angle" if self.drive.free else "prescribed"
         self.layout = DofLayout.clamped_filament(self.nb, self.ne, motor, n_motors=len(parts))
         self.ny = self.layout.size
+        #: the filaments' unknowns ``[x, theta, phi]``, the first ``n_rod`` of ``y``; a system
+        #: with more parts after them (a free body's pose: :mod:`flagwrap.system.swimmer`)
+        #: has ``ny > n_rod``
+        self.n_rod = self.ny
         self.sl_x = self.layout["x"]
         self.sl_th = self.layout["theta"]
         self.sl_phi = self.layout["phi"]
@@ -284,6 +288,7 @@ class RodSystem:
         """The fused kernel alone, part by part: ``(G, x, theta, gx, gth, d1, rt, dist, E, Ec)``."""
         N = self.N
         G = np.empty(self.ny)
+        G[self.n_rod:] = 0.0  # nothing depends on a free body's pose
         x = np.empty((N, 3))
         theta = np.empty(N - len(self.parts))
         gx = np.empty((N, 3))
@@ -295,7 +300,8 @@ class RodSystem:
         E = Ec = 0.0
         for p in self.parts:
             v, e = p.beads, p.bonds
-            yk, Gk = (y, G) if p.ymap is None else (y[p.ymap], np.empty(p.ny))
+            yk, Gk = ((y[:self.n_rod], G[:self.n_rod]) if p.ymap is None
+                      else (y[p.ymap], np.empty(p.ny)))
             Ek, Eck = SK.generalized_forces(
                 yk, *p.kernel_args(base, self.body, self._has_body), Gk, x[v], theta[e], gx[v],
                 gth[e], d1[e], rt[v], dist[v], self.body.shape_code)
@@ -396,7 +402,7 @@ class RodSystem:
             return None
         h = self.fd_step
         m = self.drive.mobility(omega)
-        rows = np.zeros((len(self.parts), self.ny))
+        rows = np.zeros((len(self.parts), len(y)))
         yp = np.array(y, float)
         for motor, p in enumerate(self.parts):
             near = [3 * k + c for k in range(min(3, p.nb)) for c in range(3)]
@@ -516,7 +522,8 @@ class RodSystem:
         trips = []
         for p in self.parts:
             colors = p.colors or p.build_colors()
-            yk, Gk = (y, G0) if p.ymap is None else (y[p.ymap], G0[p.ymap])
+            yk, Gk = ((y[:self.n_rod], G0[:self.n_rod]) if p.ymap is None
+                      else (y[p.ymap], G0[p.ymap]))
             r, c, v = SK.fd_jacobian_coo(yk, Gk, delta, *colors, p.N,
                                          *p.kernel_args(base, self.body, self._has_body),
                                          self.body.shape_code)

@@ -223,64 +223,69 @@ def rotation(axis, angle: float) -> np.ndarray:
     return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
 
 
-class RotatingSystem:
+class RotatingSystem(RodSystem):
     """A :class:`~flagwrap.system.rod_system.RodSystem` stepped in the frame turning with its
-    motor (``numerics.frame = "rotating"``).
+    motor (``numerics.frame = "rotating"``): the same system (its parts, layout, mobility and
+    interactions, shared, not copied) under the equations of this frame.
 
-    The state vector keeps the lab layout, motor angle included (``dphi/dt = omega``, the
-    angle of the frame). Its positions and reference frames are in the turning frame. The forces are
-    evaluated with the clamp at ``phi = 0``, and the velocity gains the terms of the module
-    docstring. Everything else (layout, mobility blocks, Jacobian triplets) is the lab
-    system's: the rotation terms are not stiff (rate ``omega``), so ``W`` leaves them out, and
-    the W-methods keep their order for such a ``W``. The Jacobian's motor-angle column is
-    dropped: in this frame no force depends on the motor angle. :meth:`record_view` turns a
-    state back to the lab frame for the run file.
+    ``RotatingSystem(system)`` is a transformation, not a wrapper: the result *is* a
+    ``RodSystem`` over the same data, with the methods that differ in this frame overridden
+    and every other one the lab system's own (nothing is forwarded). The state vector keeps
+    the lab layout, motor angle included (``dphi/dt = omega``, the angle of the frame); its
+    positions and reference frames are in the turning frame. The forces are evaluated with
+    the clamp at ``phi = 0``, and the velocity gains the terms of the module docstring. The
+    rotation terms are not stiff (rate ``omega``), so ``W`` leaves them out, and the
+    W-methods keep their order for such a ``W``. The Jacobian's motor-angle column is
+    dropped: in this frame no force depends on the motor angle. :meth:`pack` takes lab
+    positions and :meth:`record_view` turns a state back to the lab frame for the run file.
     """
 
     def __init__(self, system):
         check_rotating_frame(system)
-        self.inner = system
+        self.__dict__.update(system.__dict__)  # the same parts and buffers: a view
         self.axis = np.asarray(system.joint.axis, float)
         self._A = cross_matrix(self.axis)
 
-    def __getattr__(self, name):  # everything not overridden is the lab system's
-        return getattr(self.inner, name)
-
     def _at_zero(self, y) -> np.ndarray:
         y0 = np.array(y, float)
-        y0[self.inner.i_phi] = 0.0
+        y0[self.i_phi] = 0.0
         return y0
 
+    def _lab_rotation(self, phi) -> np.ndarray:
+        return rotation(self.axis, float(phi))
+
+    def pack(self, x, theta, phi) -> np.ndarray:
+        """``y`` of this frame from lab-frame beads ``x`` at motor angle ``phi``: the
+        positions turned back by ``phi`` about the motor axis (through the origin, where the
+        frame's axis is: :func:`check_rotating_frame`)."""
+        x_frame = np.asarray(x, float) @ self._lab_rotation(phi)  # R^T x, row by row
+        return RodSystem.pack(self, x_frame, theta, phi)
+
     def unpack(self, y):
-        x, theta, _ = self.inner.unpack(self._at_zero(y))
-        return x, theta, float(y[self.inner.i_phi])
+        x, theta, _ = RodSystem.unpack(self, self._at_zero(y))
+        return x, theta, float(y[self.i_phi])
 
     def forces(self, y, base):
-        return self.inner.forces(self._at_zero(y), base)
+        return RodSystem.forces(self, self._at_zero(y), base)
 
     def velocity(self, y, info, omega: float) -> np.ndarray:
-        s = self.inner
-        f = s.apply_mobility(y, info.G)
-        subtract_rotation(f, s, info, omega, self.axis, self._A)
-        f[s.i_phi] = omega
+        f = self.apply_mobility(y, info.G)
+        subtract_rotation(f, self, info, omega, self.axis, self._A)
+        f[self.i_phi] = omega
         return f
 
     def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
-        r, c, v = self.inner.force_jacobian_coo(self._at_zero(y), base, G0, delta, nonlocal_terms)
-        keep = c != self.inner.i_phi
+        r, c, v = RodSystem.force_jacobian_coo(self, self._at_zero(y), base, G0, delta,
+                                               nonlocal_terms)
+        keep = c != self.i_phi
         return r[keep], c[keep], v[keep]
 
-    # the lab system's own assembly, over this frame's forces, velocity and triplets
-    rhs = RodSystem.rhs
-    force_jacobian = RodSystem.force_jacobian
-    force_jacobian_sparse = RodSystem.force_jacobian_sparse
-
     def interaction_jacobian_coo(self, y, which: str = "all"):
-        return self.inner.interaction_jacobian_coo(self._at_zero(y), which)
+        return RodSystem.interaction_jacobian_coo(self, self._at_zero(y), which)
 
     def motor_torque(self, info, phi: float, omega: float, y=None) -> float:
         """The lab system's, from forces evaluated here with the clamp at ``phi = 0``."""
-        return self.inner.motor_torque(info, 0.0, omega)
+        return RodSystem.motor_torque(self, info, 0.0, omega)
 
     def record_view(self, y, info):
         """``info`` with its positions, gradients and reference frames turned by the motor
@@ -289,7 +294,7 @@ class RotatingSystem:
 
         from flagwrap.elasticity.rod import Frames
 
-        R = rotation(self.axis, float(y[self.inner.i_phi]))
+        R = self._lab_rotation(y[self.i_phi])
         fr = info.frames
         return dataclasses.replace(info, x=info.x @ R.T, grad_x=info.grad_x @ R.T,
                                    frames=Frames(fr.t @ R.T, fr.d1 @ R.T, fr.rt))

@@ -54,6 +54,7 @@ from flagwrap.body.solver import LaggedScreening
 from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.hydrodynamics.polydisperse import rpy_cross_block
 from flagwrap.system.layout import DofLayout
+from flagwrap.system.rod_system import RodSystem
 from flagwrap.system.rotating import (RotatingFrame, check_rotating_frame, cross_matrix,
                                       subtract_rotation)
 
@@ -73,12 +74,17 @@ def quaternion_rate(q, omega_body) -> np.ndarray:
                            w * b + z * a - x * c, w * c + x * b - y * a])
 
 
-class SwimmerSystem:
+class SwimmerSystem(RodSystem):
     """A :class:`~flagwrap.system.rod_system.RodSystem` (in the body frame, free-space bead
     mobility) with a force- and torque-free no-slip body (module docstring).
 
-    ``system``: the filament's system; ``blobs``, ``blob_radii``: the body's surface in body
-    coordinates (core units). Everything not overridden here is the filament system's.
+    ``SwimmerSystem(system, blobs, blob_radii)`` is a transformation of ``system``, not a
+    wrapper: the same parts, mobility and interactions (shared, not copied) with one more
+    part, the free body, whose pose ``[X (3), q (4)]`` follows the filaments' unknowns in the
+    layout (``n_rod`` of them, ``ny = n_rod + 7``), and the equations of the body's frame.
+    What differs from the fixed rig (the mobility, the stage solver, packing with a pose,
+    the lab view) is overridden here; everything else is ``RodSystem``'s own method on this
+    layout. ``blobs``, ``blob_radii``: the body's surface in body coordinates (core units).
     """
 
     def __init__(self, system, blobs, blob_radii, solver: str = "direct"):
@@ -88,7 +94,9 @@ class SwimmerSystem:
             raise ValueError("SwimmerSystem needs the filament's free-space direct RPY mobility")
         if np.any(system.gravity):
             raise ValueError("SwimmerSystem: gravity on a free cell is not modelled")
-        self.inner = system
+        if system.ny != system.n_rod:
+            raise ValueError("SwimmerSystem: the system has a free body already")
+        self.__dict__.update(system.__dict__)  # the same parts and buffers: a view
         self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
         self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
                                                dtype=np.float64)
@@ -99,7 +107,8 @@ class SwimmerSystem:
         R = self.K.T @ self._MinvK
         self.body_mobility = np.linalg.inv(0.5 * (R + R.T))
         s = system
-        self.n_in = s.ny
+        #: the filaments' unknowns (``n_rod``), before the pose
+        self.n_in = s.n_rod
         self.layout = DofLayout([(b.name, b.kind, b.size) for b in s.layout.blocks]
                                 + [("body_x", "position", 3), ("body_q", "angle", 4)])
         self.ny = self.layout.size
@@ -113,34 +122,22 @@ class SwimmerSystem:
         self._geometry_y = None
         self._a_buffers = None
 
-    def __getattr__(self, name):  # everything not overridden is the filament system's
-        return getattr(self.inner, name)
-
     # state ---------------------------------------------------------------------------------
-    def initial_y(self) -> np.ndarray:
-        return np.concatenate([self.inner.initial_y(), np.zeros(3), [1.0, 0.0, 0.0, 0.0]])
-
-    def unpack(self, y):
-        return self.inner.unpack(y[:self.n_in])
+    def pack(self, x, theta, phi, X=(0.0, 0.0, 0.0), q=(1.0, 0.0, 0.0, 0.0)) -> np.ndarray:
+        """``y`` from the beads ``x`` and twist angles in the body frame, the motor angle(s)
+        and the body's pose (lab position ``X`` of its reference point, unit quaternion ``q``
+        body -> lab; default: at the origin, unturned)."""
+        y = np.empty(self.ny)
+        y[:self.n_in] = RodSystem.pack(self, x, theta, phi)[:self.n_in]
+        y[self.sl_X] = X
+        y[self.sl_q] = q
+        return y
 
     def pose(self, y) -> tuple[np.ndarray, np.ndarray]:
         """``(X, R)``: the body's reference point in the lab and its rotation (body -> lab)."""
         return np.array(y[self.sl_X]), quaternion_matrix(y[self.sl_q])
 
-    # forces: the filament's, in the body frame (nothing depends on the pose) ----------------
-    def forces(self, y, base):
-        return self.inner.forces(y[:self.n_in], base)
-
-    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
-        return self.inner.force_jacobian_coo(y[:self.n_in], base, None if G0 is None else
-                                             G0[:self.n_in], delta, nonlocal_terms)
-
-    def interaction_jacobian_coo(self, y, which: str = "all"):
-        return self.inner.interaction_jacobian_coo(y[:self.n_in], which)
-
-    def force_jacobian(self, y, base, G0=None, delta=None) -> np.ndarray:
-        """``dG/dy`` over the filament's unknowns (n_in, n_in)."""
-        return self.inner.force_jacobian(y[:self.n_in], base, G0, delta)
+    # forces: RodSystem's, in the body frame (nothing depends on the pose: G's pose rows 0)
 
     # mobility ------------------------------------------------------------------------------
     def _geometry(self, y):
@@ -148,7 +145,7 @@ class SwimmerSystem:
 
         The last state's are kept: a step's stage solver and its first velocity ask at the same
         ``y``, and ``M_fb`` (beads x blobs) is the costliest thing built per call."""
-        s = self.inner
+        s = self
         yin = y[:self.n_in]
         if self._geometry_y is not None and np.array_equal(yin, self._geometry_y):
             return self._geometry_out
@@ -189,7 +186,7 @@ class SwimmerSystem:
 
     def _solve(self, y, G):
         """:meth:`body_velocity` and the geometry it used: ``(V, v, lambda, x_free, t)``."""
-        s = self.inner
+        s = self
         xf, t, C = self._geometry(y)
         F = np.asarray(G[s.sl_x]).reshape(-1, 3)
         tau = np.asarray(G[s.sl_th])
@@ -202,7 +199,7 @@ class SwimmerSystem:
     def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
         """``A G`` (module docstring) over the whole state: filament rows in the body frame,
         pose rows ``dX/dt = R U``, ``dq/dt = q (0, Omega) / 2``; the motor angle's row 0."""
-        s = self.inner
+        s = self
         V, v, _, xf, t = self._solve(y, G)
         U, Om = V[:3], V[3:]
         out = np.zeros(self.ny)
@@ -215,12 +212,8 @@ class SwimmerSystem:
 
     def velocity(self, y, info, omega: float) -> np.ndarray:
         f = self.apply_mobility(y, info.G)
-        f[self.inner.sl_phi] = self.inner.motor_rate(y, info, omega)
+        f[self.sl_phi] = self.motor_rate(y, info, omega)
         return f
-
-    def rhs(self, y, base, omega):
-        info = self.forces(y, base)
-        return self.velocity(y, info, omega), info
 
     def mobility_matrix(self, y, screening=True, reuse: bool = False) -> np.ndarray:
         """Dense ``A`` over the filament's unknowns (n_in, n_in; motor-angle row and column 0):
@@ -232,7 +225,7 @@ class SwimmerSystem:
         ``reuse=True`` (the stage solver, once a step): built in buffers the system keeps, so
         the result is valid until the next reusing call, and the body's rows ``N D`` kept
         for the pose rows of ``W``."""
-        s = self.inner
+        s = self
         xf, t, C = self._geometry(y)
         n3 = 3 * s.nb
         if reuse:
@@ -312,20 +305,19 @@ class SwimmerW:
         from flagwrap.system.kernels import left_product_coo, w_transpose_dense
 
         n = system.n_in
-        inner = system.inner
-        rows, cols, vals = inner.force_jacobian_coo(y[:n], base, G0[:n])
+        rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n])
         # the screening only while no bead touches the body: with a bead in contact the
         # screened W misses the stiff (dA/dx)[F_contact] of a mobility that falls steeply at
         # the wall, and the controller alternates accepted and rejected steps (measured:
         # 300 of 300 rejected from a wrapped C. insecticola state, 20 without the screening)
-        touching = inner.forces(y[:n], base).contact_energy > 0.0
+        touching = system.forces(y, base).contact_energy > 0.0
         A = system.mobility_matrix(y, screening=False if touching else "lagged", reuse=True)
         WT = system.__dict__.get("_wt_buffer")
         if WT is None:
             WT = system._wt_buffer = np.empty((n, n))
         w_transpose_dense(rows, cols, vals, A, _NO_TWIST_BLOCK, gamma_h, WT)  # Mob = A whole
-        if inner.drive.free:  # a torque motor's row, as the rig's DenseW
-            add_motor_rows(WT, inner, y[:n], base, gamma_h, omega)
+        if system.drive.free:  # a torque motor's row, as the rig's DenseW
+            add_motor_rows(WT, system, y[:n], base, gamma_h, omega)
         self.n = n
         self.lu = lu_of_transpose(WT)
         q = y[system.sl_q] / np.linalg.norm(y[system.sl_q])
@@ -356,7 +348,7 @@ class SwimmerFrame(RotatingFrame):
     """
 
     def __init__(self, swimmer, omega: float):
-        check_rotating_frame(swimmer.inner)
+        check_rotating_frame(swimmer)
         self._setup(swimmer, omega, swimmer.n_in - 1)
 
     def full(self, z) -> np.ndarray:
@@ -372,7 +364,7 @@ class SwimmerFrame(RotatingFrame):
         info = s.forces(y, base)
         f = s.apply_mobility(y, info.G)[:s.n_in]
         f *= self.scale(machin)
-        subtract_rotation(f, s.inner, info, self.omega, self.axis, self._A)
+        subtract_rotation(f, s, info, self.omega, self.axis, self._A)
         return f[:self.n], info
 
     def _mobility_jacobian(self, y, info, JG) -> np.ndarray:
@@ -396,7 +388,6 @@ def make_swimmer(config):
     """The free-swimming system of ``config`` (``body.motion = "free"``)."""
     from flagwrap.body.multiblob import cell_body_blobs
     from flagwrap.hydrodynamics.mobility import RPYMobility
-    from flagwrap.system.rod_system import RodSystem
 
     fil = config.filament
     inner = RodSystem(config, mobility=RPYMobility(fil.bead_radius / fil.length))
