@@ -570,6 +570,12 @@ class Flagellum:
     body). ``spin_deg`` [deg] turns the filament's shape about its motor axis (default: the
     azimuth, so that anchors spread by azimuth carry copies of one shape turned about the
     body axis: a symmetric tuft).
+
+    ``protocol``: this flagellum's motor schedule, phases as ``motor.protocol``'s (default:
+    ``motor.protocol``, which every motor without its own follows). It must last as long as
+    ``motor.protocol`` (the run's length and the phases of its swimming summary), e.g. one
+    motor reversing two turns after the others, or staying CCW while they reverse
+    (docs/bundle.md). The motor law (``motor.kind``) is every motor's.
     """
 
     polar_deg: float | None = None
@@ -577,6 +583,7 @@ class Flagellum:
     spin_deg: float | None = None
     anchor: tuple | None = None
     axis: tuple | None = None
+    protocol: tuple | None = None
 
     def __post_init__(self, where: str = "flagellum"):
         on_cap = self.polar_deg is not None or self.azimuth_deg is not None
@@ -603,6 +610,12 @@ class Flagellum:
                 raise UserInputError(f"{where}.axis must not be zero")
         if self.spin_deg is not None:
             _finite(f"{where}.spin_deg", self.spin_deg)
+        if self.protocol is not None:
+            if not isinstance(self.protocol, (list, tuple)) or not self.protocol:
+                raise UserInputError(f"{where}.protocol must be a non-empty array of phases, "
+                                     f"got {self.protocol!r}")
+            _set(self, "protocol", tuple(p if isinstance(p, Phase) else Phase(**p)
+                                         for p in self.protocol))
 
 
 @dataclass(frozen=True)

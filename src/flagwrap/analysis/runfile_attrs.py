@@ -38,8 +38,8 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None,
                     filament: int = 0) -> BucklingAnalysis:
     """Run :class:`BucklingAnalysis` on a run dataset (:func:`flagwrap.io.runfile.read_run`),
     on its flagellum ``filament`` (a run of several: :func:`~flagwrap.io.runfile.
-    filament_slices`), with its own motor's torque (``motor_torques``; a file without them:
-    the run's, all motors' sum)."""
+    filament_slices`), with its own motor's torque and rate (``motor_torques``,
+    ``motor_rates``; a file without them: the run's, all motors' sum, and motor 0's rate)."""
     from flagwrap.io.runfile import config_of, filament_slices
 
     need = ("position", "turns", "omega")
@@ -62,7 +62,18 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None,
 
         x = body_frame(x, ds["body_position"].values, ds["body_orientation"].values)
     x = x[:, filament_slices(ds)[filament]]
-    return a.compute(ds["turns"].values, x, ds["omega"].values,
+    # several flagella: this one's own motor rate (its protocol, its load); a motor that
+    # never reverses ([[flagellum]] protocol) is read against the run's reversal: its state
+    # after the others reversed, flagged motor_reversed = False
+    om = ds["omega"].values
+    a.motor_reversed = True
+    if "motor_rates" in ds.variables:
+        own = ds["motor_rates"].values[:, filament]
+        if (own < 0).any() or not (om < 0).any():
+            om = own
+        else:
+            a.motor_reversed = False
+    return a.compute(ds["turns"].values, x, om,
                      float(ds.attrs["length"]), cfg.body.resolved_radius(R),
                      cfg.body.resolved_length(R), tq, body_shape=cfg.body.shape)
 
@@ -103,7 +114,8 @@ def annotate(ds, analysis, bundle: dict | None = None):
     if many:
         from flagwrap.sweep.store import jsonable as _jsonable
 
-        out.attrs[PREFIX + "filaments"] = json.dumps(_jsonable([a.summary() for a in each]))
+        out.attrs[PREFIX + "filaments"] = json.dumps(_jsonable([flagellum_summary(a)
+                                                                 for a in each]))
     from flagwrap import __version__
 
     out.attrs[PREFIX + "version"] = __version__
@@ -133,11 +145,17 @@ def annotate(ds, analysis, bundle: dict | None = None):
     return out
 
 
+def flagellum_summary(a) -> dict:
+    """One flagellum's :meth:`BucklingAnalysis.summary` and whether its own motor reversed
+    (:func:`analyze_dataset`)."""
+    return {**a.summary(), "motor_reversed": bool(getattr(a, "motor_reversed", True))}
+
+
 def combined_summary(analyses) -> dict:
     """A run of several flagella as one verdict: the summary of the first flagellum to buckle
     (earliest threshold crossing; flagellum 0 if none does), with ``filament`` its index and
     ``n_buckled`` how many buckled. Critical-M searches and sweeps read this."""
-    sums = [a.summary() for a in analyses]
+    sums = [flagellum_summary(a) for a in analyses]
     buckled = [k for k, s in enumerate(sums) if s["buckled"]]
     first = min(buckled, key=lambda k: sums[k]["crossing_turns"]) if buckled else 0
     return {**sums[first], "filament": first, "n_buckled": len(buckled)}
@@ -207,7 +225,7 @@ def _analyze_flagella(ds, analysis, slices, path, write: bool) -> dict:
     if write:
         write_dataset_atomic(annotate(ds, each, bundle), path)
     res = {**combined_summary(each), **joint_summary(ds)}
-    res["filaments"] = [a.summary() for a in each]
+    res["filaments"] = [flagellum_summary(a) for a in each]
     res["bundle"] = {k: v for k, v in bundle.items() if not k.endswith("_series")}
     res["_first"] = each[res["filament"]]
     return res

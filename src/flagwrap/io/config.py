@@ -131,19 +131,7 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
             if _is_number(table.get(key)):
                 table[key] = table[key] * factor
         if section == "motor" and "protocol" in table:
-            prot = table["protocol"]
-            if not isinstance(prot, list):
-                raise UserInputError("motor.protocol must be an array of tables")
-            phases = []
-            for k, p in enumerate(prot):
-                if not isinstance(p, dict):
-                    raise UserInputError(f"motor.protocol[{k}] must be a table")
-                _check_types(f"motor.protocol[{k}]", Phase, p)
-                missing = [f for f in ("direction", "turns") if f not in p]
-                if missing:
-                    raise UserInputError(f"motor.protocol[{k}] is missing {', '.join(missing)}")
-                phases.append(Phase(**p))
-            table["protocol"] = tuple(phases)
+            table["protocol"] = _phases(table["protocol"], "motor.protocol")
         try:
             kwargs[section] = cls(**table)
         except TypeError as exc:  # missing required fields
@@ -156,6 +144,22 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
     if not isinstance(nm, str) or not nm:
         raise UserInputError("name must be a non-empty string")
     return Config(name=nm, **kwargs)
+
+
+def _phases(prot, where: str) -> tuple:
+    """A protocol: an array of phase tables -> :class:`~flagwrap.params.Phase` s."""
+    if not isinstance(prot, list):
+        raise UserInputError(f"{where} must be an array of tables")
+    phases = []
+    for k, p in enumerate(prot):
+        if not isinstance(p, dict):
+            raise UserInputError(f"{where}[{k}] must be a table")
+        _check_types(f"{where}[{k}]", Phase, p)
+        missing = [f for f in ("direction", "turns") if f not in p]
+        if missing:
+            raise UserInputError(f"{where}[{k}] is missing {', '.join(missing)}")
+        phases.append(Phase(**p))
+    return tuple(phases)
 
 
 def _flagella(tables, lf: float) -> tuple:
@@ -174,9 +178,13 @@ def _flagella(tables, lf: float) -> tuple:
             if key not in known:
                 raise UserInputError(f"unknown key {where}.{_show(key)}; allowed: "
                                      f"{', '.join(sorted(known))}")
+            if key == "protocol":
+                continue
             if isinstance(value, dict) or (isinstance(value, list) and key not in ("anchor", "axis")):
                 raise UserInputError(f"{where}.{key} must be a single value")
         t = dict(t)
+        if "protocol" in t:
+            t["protocol"] = _phases(t["protocol"], f"{where}.protocol")
         if isinstance(t.get("anchor"), list) and all(_is_number(c) for c in t["anchor"]):
             t["anchor"] = [c * lf for c in t["anchor"]]
         try:
@@ -218,6 +226,12 @@ def _toml_value(v) -> str:
     raise TypeError(type(v))
 
 
+def _toml_protocol(phases) -> str:
+    items = ", ".join("{ " + ", ".join(f"{pk} = {_toml_value(pv)}" for pk, pv in p.items()) + " }"
+                      for p in phases)
+    return f"protocol = [{items}]"
+
+
 def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
     """Serialise a config (SI units) to TOML text that :func:`load_config` reads back.
 
@@ -232,18 +246,16 @@ def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
         lines.append(f"[{section}]")
         for k, v in table.items():
             if k == "protocol":
-                items = ", ".join(
-                    "{ " + ", ".join(f"{pk} = {_toml_value(pv)}" for pk, pv in p.items()) + " }"
-                    for p in v
-                )
-                lines.append(f"protocol = [{items}]")
+                lines.append(_toml_protocol(v))
             else:
                 lines.append(f"{k} = {_toml_value(v)}")
         lines.append("")
     for table in d.get("flagellum", []):
         lines.append("[[flagellum]]")
         for k, v in table.items():
-            if isinstance(v, (list, tuple)):
+            if k == "protocol":
+                lines.append(_toml_protocol(v))
+            elif isinstance(v, (list, tuple)):
                 lines.append(f"{k} = [{', '.join(_toml_value(c) for c in v)}]")
             else:
                 lines.append(f"{k} = {_toml_value(v)}")

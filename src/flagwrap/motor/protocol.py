@@ -60,3 +60,42 @@ class Schedule:
     def switch_times(self):
         """Start times of the phases after the first."""
         return [s.t0 for s in self.segments[1:]]
+
+
+class MotorSchedules(Schedule):
+    """Every motor's ``omega(t)`` when flagella have their own protocols
+    (``[[flagellum]] protocol``): a :class:`Schedule` whose segments are the intervals
+    between any motor's switch times, each with ``omega`` one value per motor, (n_motors,),
+    and ``label`` the reference protocol's (``motor.protocol``: the run's length and the
+    phases its summaries use). :func:`motor_schedule` builds one only where the protocols
+    differ; a system of motors that share one keeps the scalar :class:`Schedule`."""
+
+    def __init__(self, reference, protocols):
+        ref = Schedule(reference)
+        each = [Schedule(p) for p in protocols]
+        cuts = sorted({0.0, ref.t_end, *(s.t1 for m in each for s in m.segments
+                                          if s.t1 < ref.t_end)})
+        segs = []
+        for t0, t1 in zip(cuts[:-1], cuts[1:]):
+            if t1 - t0 <= 1e-12 * ref.t_end:
+                continue
+            mid = 0.5 * (t0 + t1)
+            segs.append(Segment(t0, t1, np.array([m(mid) for m in each]),
+                                ref.segments[ref.segment_index(mid)].label))
+        self.segments = tuple(segs)
+        self.t_end = ref.t_end
+        self.reference = ref
+
+    def angle(self, t) -> np.ndarray:  # pragma: no cover - not meaningful for several
+        raise NotImplementedError("MotorSchedules: each motor has its own angle")
+
+
+def motor_schedule(config):
+    """``config``'s motor schedule: one :class:`Schedule` when every motor follows
+    ``motor.protocol``; :class:`MotorSchedules` when a ``[[flagellum]]`` has a protocol of its
+    own."""
+    ref = config.motor.protocol
+    own = [f.protocol for f in config.flagella]
+    if not any(p is not None and tuple(p) != tuple(ref) for p in own):
+        return Schedule(ref)
+    return MotorSchedules(ref, [ref if p is None else p for p in own])

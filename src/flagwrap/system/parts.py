@@ -319,6 +319,24 @@ def check_flagella(config) -> None:
             if not float(shape.normal(p) @ np.asarray(f.axis, float)) > 0.0:
                 raise UserInputError(f"{where}.axis = {list(f.axis)} points into the body; the "
                                      "motor axis must point out of it")
+    from flagwrap.motor.protocol import Schedule
+
+    t_ref = Schedule(config.motor.protocol).t_end
+    for k, f in enumerate(config.flagella):
+        if f.protocol is None:
+            continue
+        t_k = Schedule(f.protocol).t_end
+        if abs(t_k - t_ref) > 1e-9 * t_ref:
+            raise UserInputError(
+                f"flagellum[{k}].protocol lasts {t_k / (2 * math.pi):.6g} reference turns, "
+                f"motor.protocol {t_ref / (2 * math.pi):.6g}: a flagellum's protocol must "
+                "last as long as the run's (sum of turns / speed)")
+        if config.motor.kind != "speed":
+            for p in f.protocol:
+                if p.direction != "stop" and p.speed != 1.0:
+                    raise UserInputError(
+                        f"flagellum[{k}].protocol speed = {p.speed:g}: a {config.motor.kind} "
+                        "motor sets its own speed; leave the phases' speed at 1")
     if len(config.flagella) > 1 and config.numerics.frame != "lab":
         raise UserInputError(f"numerics.frame = {config.numerics.frame!r} needs one flagellum on "
                              f"the motor axis; this config has {len(config.flagella)} "

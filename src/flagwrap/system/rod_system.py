@@ -34,7 +34,7 @@ from flagwrap.body.cell_body import BodyContact, NoBody, ShapeContact, body_mobi
 from flagwrap.elasticity.rod import Frames
 from flagwrap.hydrodynamics.mobility import make_mobility
 from flagwrap.motor.drive import make_drive
-from flagwrap.motor.protocol import Schedule
+from flagwrap.motor.protocol import motor_schedule
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.parts import build_parts
 
@@ -53,6 +53,12 @@ class ForceInfo:
     grad_theta: np.ndarray
     distance: np.ndarray
     interaction_energy: float = 0.0
+
+
+def motor_omega(omega, k: int) -> float:
+    """Motor ``k``'s speed from the schedule's ``omega``: one value for every motor, or one
+    per motor (:class:`~flagwrap.motor.protocol.MotorSchedules`)."""
+    return omega if np.ndim(omega) == 0 else float(omega[k])
 
 
 class SeveralFilaments(TypeError):
@@ -141,7 +147,11 @@ class RodSystem:
             for p in parts:
                 active[p.bead0:p.bead0 + p.nc] = False
             self._shape_contact = ShapeContact(self.body, active)
-        self.schedule = Schedule(config.motor.protocol)
+        self.schedule = motor_schedule(config)
+        n_own = np.size(self.schedule.segments[0].omega)
+        if n_own > 1 and n_own != len(parts):
+            raise ValueError(f"RodSystem: {n_own} [[flagellum]] protocols for {len(parts)} "
+                             "filaments (placements given apart from the config's tables?)")
         self.interactions = self._config_interactions() + list(interactions)
         if self._shape_contact is not None:
             self.interactions.insert(0, self._shape_contact)
@@ -380,8 +390,8 @@ class RodSystem:
         if not self.drive.free:
             return omega
         if len(self.parts) == 1:
-            return self.drive.rate(omega, self.motor_force(y, info))
-        return np.array([self.drive.rate(omega, self.motor_force(y, info, k))
+            return self.drive.rate(motor_omega(omega, 0), self.motor_force(y, info))
+        return np.array([self.drive.rate(motor_omega(omega, k), self.motor_force(y, info, k))
                          for k in range(len(self.parts))])
 
     def motor_force(self, y, info: ForceInfo, motor: int = 0) -> float:
@@ -401,10 +411,10 @@ class RodSystem:
         if not self.drive.free:
             return None
         h = self.fd_step
-        m = self.drive.mobility(omega)
         rows = np.zeros((len(self.parts), len(y)))
         yp = np.array(y, float)
         for motor, p in enumerate(self.parts):
+            m = self.drive.mobility(motor_omega(omega, motor))
             near = [3 * k + c for k in range(min(3, p.nb)) for c in range(3)]
             near += [3 * p.nb + j for j in range(min(3, p.ne))] + [p.ny - 1]  # its own order
             if p.ymap is not None:
@@ -562,20 +572,24 @@ class RodSystem:
         if len(self.parts) > 1:
             return float(np.sum(self.motor_torques(info, phi, omega, y)))
         dEdphi = self.clamp.generalized_force(phi, info.grad_x, info.grad_theta)
+        omega = motor_omega(omega, 0)
         if not self.drive.free:
             return dEdphi + self.machin * self.rot_drag[0] * omega
         return self.drive.torque(self.drive.rate(omega, -dEdphi), omega)
 
     def motor_torques(self, info: ForceInfo, phi: float, omega: float, y=None) -> np.ndarray:
-        """Each motor's axial torque [A/L] about its own axis, (n_filaments,): speed motors
-        turn together, all at angle ``phi``; torque motors at their own angles in ``y``."""
+        """Each motor's axial torque [A/L] about its own axis, (n_filaments,), each at its own
+        angle in ``y`` (speed motors without ``y``: all at ``phi``) and its own speed in
+        ``omega`` (:func:`motor_omega`)."""
         if len(self.parts) == 1:
             return np.array([self.motor_torque(info, phi, omega)])
         if self.drive.free:
             if y is None:
                 raise ValueError("motor_torques: torque motors need the state y")
-            return np.array([self.drive.torque(self.drive.rate(omega, self.motor_force(y, info, k)),
-                                               omega) for k in range(len(self.parts))])
-        return np.array([p.joint.generalized_force(phi, info.grad_x[p.beads],
-                                                   info.grad_theta[p.bonds])
-                         + self.machin * p.rot_drag[0] * omega for p in self.parts])
+            return np.array([self.drive.torque(
+                self.drive.rate(motor_omega(omega, k), self.motor_force(y, info, k)),
+                motor_omega(omega, k)) for k in range(len(self.parts))])
+        return np.array([p.joint.generalized_force(y[self.i_phi + k] if y is not None else phi,
+                                                   info.grad_x[p.beads], info.grad_theta[p.bonds])
+                         + self.machin * p.rot_drag[0] * motor_omega(omega, k)
+                         for k, p in enumerate(self.parts)])
