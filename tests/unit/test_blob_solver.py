@@ -102,3 +102,33 @@ def test_lagged_screening_stays_out_of_w_with_the_krylov_solver(body):
     lag = LaggedScreening(mob._solver, b, mob._cross)
     assert lag(x) is None and lag.computed == 0 and lag.memory().size == 0
     assert np.array_equal(mob.stage_matrix(x), mob._free.matrix(x))
+
+
+def test_the_krylov_bodys_mobility_never_stores_the_beads_x_blobs_block(body, monkeypatch):
+    # with the Krylov blob solver the bead-blob products are computed pair by pair
+    # (hydrodynamics.polydisperse.rpy_cross_apply); they are the stored block's products
+    # (same pair law, summed in another order: 1e-13), and the mobility never builds it
+    from flagwrap.body import fixed_mobility
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
+    from flagwrap.hydrodynamics.polydisperse import rpy_cross_apply, rpy_cross_block
+
+    b, r = body
+    rng = np.random.default_rng(1)
+    x = rng.standard_normal((30, 3)) * 0.2 + [0.0, 0.0, -0.2]
+    x[0] = b[0] - [0.0, 0.0, 0.03]  # a bead overlapping a blob: the near-pair law
+    Fx, Fy = rng.standard_normal((30, 3)), rng.standard_normal((len(b), 3))
+    C = rpy_cross_block(x, 0.01, b, r)
+    ux, uy = np.empty((30, 3)), np.empty((len(b), 3))
+    rpy_cross_apply(x, 0.01, b, r, Fy, Fx, ux, uy)
+    np.testing.assert_allclose(ux.ravel(), C @ Fy.ravel(), rtol=1e-12, atol=1e-13 * np.abs(ux).max())
+    np.testing.assert_allclose(uy.ravel(), C.T @ Fx.ravel(), rtol=1e-12, atol=1e-13 * np.abs(uy).max())
+    m = FixedBodyMobility(0.01, b, r, solver="krylov")
+    assert m.matrix_free
+    stored = FixedBodyMobility(0.01, b, r, solver="krylov")
+    stored.matrix_free = False
+    want = stored.apply(x, Fx)
+    monkeypatch.setattr(fixed_mobility, "rpy_cross_block",
+                        lambda *a: pytest.fail("the (3n, 3m) block was built"))
+    got = m.apply(x, Fx)
+    # CG to rtol 1e-10 on both sides (test above): the velocities agree to ~1e-9
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-8 * np.abs(want).max())

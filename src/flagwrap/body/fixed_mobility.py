@@ -10,8 +10,9 @@ import math
 
 import numpy as np
 
-from flagwrap.body.solver import LaggedScreening, make_blob_solver, screening_matrix
-from flagwrap.hydrodynamics.polydisperse import rpy_cross_block
+from flagwrap.body.solver import (DirectBlobSolver, LaggedScreening, make_blob_solver,
+                                  screening_matrix)
+from flagwrap.hydrodynamics.polydisperse import rpy_cross_apply, rpy_cross_block
 
 
 class FixedBodyMobility:
@@ -46,6 +47,9 @@ class FixedBodyMobility:
                                                dtype=np.float64)
         self._free = RPYMobility(self.radius)
         self._solver = make_blob_solver(solver, self.blobs, self.blob_radii)
+        #: products with the beads x blobs block computed pair by pair (the Krylov blob
+        #: solver's O(n) memory), not from a stored block (the direct solver's, faster)
+        self.matrix_free = not isinstance(self._solver, DirectBlobSolver)
         self._lagged = LaggedScreening(self._solver, self.blobs, self._cross)
 
     def _cross(self, x):
@@ -84,8 +88,18 @@ class FixedBodyMobility:
 
     def apply(self, x, F):
         F = np.ascontiguousarray(F, dtype=np.float64)
-        C = self._cross(x)
-        lam = self._solver.solve(C.T @ F.ravel())
-        return self._free.apply(x, F) - (C @ lam).reshape(-1, 3)
+        if not self.matrix_free:
+            C = self._cross(x)
+            lam = self._solver.solve(C.T @ F.ravel())
+            return self._free.apply(x, F) - (C @ lam).reshape(-1, 3)
+        # the Krylov blob solver: M_bf F and M_fb lambda as products, never the (3n, 3m)
+        # block, so that memory stays linear in beads + blobs (docs/bundle.md, "Cost")
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        nb, m = len(x), len(self.blobs)
+        ub, ux, empty = np.empty((m, 3)), np.empty((nb, 3)), np.empty((0, 3))
+        rpy_cross_apply(x, self.radius, self.blobs, self.blob_radii, empty, F, ux, ub)
+        lam = np.ascontiguousarray(self._solver.solve(ub.ravel()).reshape(m, 3))
+        rpy_cross_apply(x, self.radius, self.blobs, self.blob_radii, lam, empty, ux, ub)
+        return self._free.apply(x, F) - ux
 
     apply_single = apply

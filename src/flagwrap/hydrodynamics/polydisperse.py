@@ -155,6 +155,51 @@ def rpy_cross_radii(x, a, y, b, out):
             out[k + 2, m + 2] = f + g * d2 * d2
 
 
+@nb.njit(cache=True, inline="always")
+def _cross_pair(d0, d1, d2, a, bj):
+    """``(f, g)`` of :func:`rpy_cross_radii`'s block ``f I + g d d^T`` for the separation
+    ``d``."""
+    r2 = d0 * d0 + d1 * d1 + d2 * d2
+    if r2 > (a + bj) * (a + bj):
+        ir2 = 1.0 / r2
+        c = math.sqrt(ir2) / (8.0 * math.pi)
+        s2 = (a * a + bj * bj) * ir2
+        return c * (1.0 + s2 / 3.0), c * (1.0 - s2) * ir2
+    r = math.sqrt(r2)
+    f, g = _pair(r, a, bj)
+    return f, (g / r2 if r > 0.0 else 0.0)
+
+
+@nb.njit(cache=True)
+def rpy_cross_apply(x, a, y, b, Fy, Fx, ux, uy):
+    """The products of :func:`rpy_cross_radii`'s block ``C`` without storing it (memory
+    O(n + m), time O(n m)): ``ux = C Fy`` (n, 3), the velocities at ``x`` of forces ``Fy`` on
+    the spheres at ``y``, and ``uy = C^T Fx`` (m, 3); either force may be zero-length to skip
+    its product. The blocks are symmetric, so ``C^T``'s block (j, i) is ``C``'s (i, j)."""
+    do_x = Fy.shape[0] > 0
+    do_y = Fx.shape[0] > 0
+    if do_x:
+        ux[:, :] = 0.0
+    if do_y:
+        uy[:, :] = 0.0
+    for i in range(x.shape[0]):
+        for j in range(y.shape[0]):
+            d0 = x[i, 0] - y[j, 0]
+            d1 = x[i, 1] - y[j, 1]
+            d2 = x[i, 2] - y[j, 2]
+            f, g = _cross_pair(d0, d1, d2, a, b[j])
+            if do_x:
+                dF = d0 * Fy[j, 0] + d1 * Fy[j, 1] + d2 * Fy[j, 2]
+                ux[i, 0] += f * Fy[j, 0] + g * d0 * dF
+                ux[i, 1] += f * Fy[j, 1] + g * d1 * dF
+                ux[i, 2] += f * Fy[j, 2] + g * d2 * dF
+            if do_y:
+                dF = d0 * Fx[i, 0] + d1 * Fx[i, 1] + d2 * Fx[i, 2]
+                uy[j, 0] += f * Fx[i, 0] + g * d0 * dF
+                uy[j, 1] += f * Fx[i, 1] + g * d1 * dF
+                uy[j, 2] += f * Fx[i, 2] + g * d2 * dF
+
+
 def rpy_cross_block(x, a, blobs, blob_radii) -> np.ndarray:
     """:func:`rpy_cross_radii` for beads at ``x`` (radius ``a``) and ``blobs`` in a new
     (3n, 3m) array."""
