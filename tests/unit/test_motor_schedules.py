@@ -73,7 +73,7 @@ def test_each_flagellum_far_apart_follows_its_own_single_run():
     assert np.all(rates[t_turns < 0.44, 1] == 1) and np.all(rates[t_turns > 0.46, 1] == -1)
 
 
-def test_the_run_file_and_the_analysis_read_each_motors_own_rate(tmp_path):
+def test_the_run_file_and_the_analysis_read_each_motors_own_rate(tmp_path, capsys):
     from flagwrap.analysis.runfile_attrs import analyze_dataset
     from flagwrap.io.config import config_to_toml, load_config
     from flagwrap.io.runfile import read_run, write_run
@@ -98,6 +98,11 @@ def test_the_run_file_and_the_analysis_read_each_motors_own_rate(tmp_path):
 
     res = analyze_run_file(tmp_path / "r.nc", write=False)
     assert [f["motor_reversed"] for f in res["filaments"]] == [True, False]
+    from flagwrap.cli.main import main
+
+    assert main(["analyze", str(tmp_path / "r.nc")]) == 0
+    out = capsys.readouterr().out
+    assert "flagellum 1:" in out and "its motor never reversed" in out.split("flagellum 1:")[1]
 
 
 @pytest.mark.parametrize("own, match", [

@@ -106,7 +106,9 @@ def run(args) -> int:
                 tc = f["waiting_time_turns"]
                 print(f"  flagellum {k}: {f['state']}, buckled {f['buckled']}, t_c/T "
                       f"{'-' if tc != tc else format(tc, '.3f')}, final height "
-                      f"{f['final_height']:+.4f}, winding {f['winding_turns']:.3f} turns")
+                      f"{f['final_height']:+.4f}, winding {f['winding_turns']:.3f} turns"
+                      + ("" if f.get("motor_reversed", True) else
+                         " (its motor never reversed: read against the run's reversal)"))
             b = res["bundle"]
             lags = ", ".join(f"{math.degrees(v):+.0f}" for v in b["phase_lag"])
             print(f"  bundle (final turns): separation {b['separation']:.3f} R "
