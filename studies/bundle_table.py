@@ -52,7 +52,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("runs", nargs="+", type=Path)
     args = p.parse_args(argv)
-    print("| run | eta [mPa s] | M (one filament) | verdict, t_c/T after reversal | state "
+    print("| run | eta [mPa s] | M (its filament) | verdict, t_c/T after reversal | state "
           "(each flagellum) | winding [turns] | separation [R] | swimming CCW / CW / last turn "
           "[um/s] | CW motor torque max [pN nm] (each) | steps | wall [min] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
