@@ -3,13 +3,29 @@
 import argparse
 import functools
 
+import pytest
+
 from flagwrap.cli import figure as cli_figure
 from flagwrap.cli import main as cli_main
 
 
-def test_registered():
+def test_every_registered_figure_is_reachable_and_an_unknown_one_refused(tmp_path, capsys):
+    # the registry, the parser and the plans agree: each name parses, has a plan and a
+    # callable, and its --dry-run says what it would do without running anything
     assert cli_main.COMMANDS["figure"] == "figure"
-    assert "fig3" in cli_figure.FIGURES
+    names = set(cli_figure.FIGURES)
+    assert {"fig3", "fig4", "fig5", "fig6"} <= names and names == set(cli_figure.PLANS)
+    p = argparse.ArgumentParser()
+    cli_figure.add_arguments(p)
+    for name in sorted(names):
+        assert callable(cli_figure.FIGURES[name])
+        args = p.parse_args([name, "-o", str(tmp_path / name), "--dry-run"])
+        assert cli_figure.run(args) == 0
+        assert f"figure {name}: {cli_figure.PLANS[name]}" in capsys.readouterr().out
+        assert not list((tmp_path / name).glob("*.png"))  # a dry run writes no figure
+    with pytest.raises(SystemExit) as exit_:
+        cli_main.main(["figure", "fig99"])
+    assert exit_.value.code == 2 and "invalid choice: 'fig99'" in capsys.readouterr().err
 
 
 def test_fig3_writes_png_and_pdf(tmp_path, monkeypatch, capsys):

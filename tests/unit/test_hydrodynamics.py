@@ -196,8 +196,18 @@ def test_auto_backend_is_direct_without_gpu_and_names_missing_packages():
     assert mob.make_mobility(True, 0.1, "auto", n=10).backend == "direct"
     assert isinstance(mob.make_mobility(False, 0.1, "fmm"), LocalMobility)
     assert mob.backend_missing("direct") is None
-    for name in ("fmm", "jax"):
-        why = mob.backend_missing(name)
-        assert why is None or "pip install" in why
+    import importlib.util
+
+    real = importlib.util.find_spec
+    for name, module in (("fmm", "fmm3dpy"), ("jax", "jax")):
+        # the package absent, then present (find_spec answering as it would)
+        importlib.util.find_spec = lambda m, *a, _mod=module: None if m == _mod else real(m, *a)
+        try:
+            assert mob.backend_missing(name) == f"needs the {module} package (pip install {module})"
+            importlib.util.find_spec = lambda m, *a, _mod=module: (object() if m == _mod
+                                                                   else real(m, *a))
+            assert mob.backend_missing(name) is None
+        finally:
+            importlib.util.find_spec = real
     with pytest.raises(ValueError, match="mobility backend"):
         mob.make_mobility(True, 0.1, "gpu")

@@ -58,7 +58,10 @@ def test_undeformed_helix_stays_put(integrator):
     cfg = make_config(protocol=(("stop", 1.0),), numerics=num)
     sim = Simulation(cfg)
     traj = sim.run()
-    assert traj.n_steps == 1000 or traj.ok
+    if integrator == "euler":  # dt = 1e-9 cannot cross a turn: stopped by the step budget
+        assert not traj.ok and traj.n_steps == 1000 and "max_steps=1000" in traj.message
+    else:  # nothing moves, so the adaptive steppers stride through the turn (6 steps)
+        assert traj.ok and traj.n_steps < 20, (traj.message, traj.n_steps)
     disp = np.abs(np.asarray(traj.x) - traj.x[0]).max()
     assert disp < 1e-8
 

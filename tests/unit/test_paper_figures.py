@@ -41,7 +41,21 @@ def test_fig4(tmp_path):
     assert (tmp_path / "f4.png").stat().st_size > 0 and (tmp_path / "f4.pdf").stat().st_size > 0
     labs = _labels(fig)
     assert any("N_m R/A" in s for s in labs) and any("z(L)" in s for s in labs)
-    assert len(fig.axes[0].lines) >= 4
+    # the data drawn are the runs': (c) every run's torque against turns, (d) the largest
+    # ratio's free-end heights, which start at -0.35 and rise to 0 one CW turn (HI) and half
+    # a turn (no HI) after the switch at 2 turns (fake_run's construction)
+    ac, ad = fig.axes[0], fig.axes[1]
+    torques = [ln for ln in ac.lines if len(ln.get_xdata()) > 2]
+    assert len(torques) == 4
+    for ln in torques:
+        np.testing.assert_allclose(ln.get_ydata(), runs[(0.85, True)]["motor_torque_reduced"])
+    heights = {ln.get_label(): ln for ln in ad.lines if len(ln.get_xdata()) > 2}
+    assert set(heights) == {"with HI", "without HI"}
+    for label, rise in (("with HI", 1.0), ("without HI", 0.5)):
+        t, h = heights[label].get_xdata(), heights[label].get_ydata()
+        np.testing.assert_allclose(h[t <= 2.0], -0.35, atol=1e-12)
+        np.testing.assert_allclose(h[t >= 2.0 + rise + 0.5], 0.0, atol=1e-12)
+        assert np.all(h[(t > 2.0 + rise + 0.01) & (t < 2.0 + rise + 0.49)] > -0.35)
 
 
 def test_fig6(tmp_path):

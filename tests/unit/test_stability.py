@@ -241,3 +241,25 @@ def test_motor_verdict_compares_the_motors_torque_at_f_c_with_the_whirls(cw31):
     slow = motor_verdict(Motor(machin=100.0, kind="torque-speed", stall_torque=1e3 * need,
                                zero_load_speed=0.4), cfg, r)  # f_0 below f_c: never
     assert slow["buckles"] is False and slow["stall_torque_needed"] == float("inf")
+
+
+def test_a_lost_branch_keeps_the_states_that_converged(monkeypatch):
+    # branch() lost every computed state when a later target failed (issue 29: the Fig. 4(a)
+    # branch at M = 1164); now the exception carries the targets reached before it
+    from flagwrap.stability import steady
+
+    frame = RotatingFrame(RodSystem(small(n_beads=21, hydrodynamics=False)), -1.0)
+    real = steady.newton
+
+    def newton_failing_above_300(frame, machin, *a, **k):
+        if machin > 300.0:
+            raise steady.NewtonFailure("forced", None)
+        return real(frame, machin, *a, **k)
+
+    monkeypatch.setattr(steady, "newton", newton_failing_above_300)
+    with pytest.raises(steady.BranchLost) as info:
+        steady.branch(frame, [100.0, 250.0, 400.0])
+    exc = info.value
+    assert sorted(exc.states) == [100.0, 250.0]
+    assert all(st.converged for st in exc.states.values())
+    assert exc.state.machin == pytest.approx(300.0, rel=1e-2) and exc.m_failed > 300.0

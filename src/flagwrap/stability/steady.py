@@ -140,11 +140,13 @@ def extrapolate(frame, a: SteadyState, b: SteadyState, machin: float) -> np.ndar
 
 
 class BranchLost(NewtonFailure):
-    """The continuation could not step beyond ``state``; ``m_failed``: the last M tried."""
+    """The continuation could not step beyond ``state``; ``m_failed``: the last M tried;
+    ``states``: the targets :func:`branch` reached before (empty from :func:`march`)."""
 
     def __init__(self, message, state, m_failed):
         super().__init__(message, state)
         self.m_failed = m_failed
+        self.states = {}
 
 
 def march(frame, cur: SteadyState, m_stop: float, factor: float = 1.25, prev=None):
@@ -213,14 +215,19 @@ def start_state(frame, machin: float, halvings: int = 8) -> SteadyState:
 
 def branch(frame, machins, m_start: float = 10.0, factor: float = 1.25) -> dict:
     """Steady states at each of ``machins``, by continuation (:func:`march`) from the rest
-    shape at ``m_start``. Returns ``{M: SteadyState}``; raises :class:`BranchLost` where the
-    branch is lost."""
+    shape at ``m_start``. Returns ``{M: SteadyState}``. Where the branch is lost it raises
+    :class:`BranchLost` and keeps what converged: the exception's ``states`` holds the
+    targets reached before (``{M: SteadyState}``) and its ``state`` the last state."""
     targets = sorted(float(m) for m in machins)
     cur = start_state(frame, min(float(m_start), targets[0]))
     prev = None
     out = {}
-    for target in targets:
-        for nxt in march(frame, cur, target, factor, prev):
-            prev, cur = cur, nxt
-        out[target] = cur
+    try:
+        for target in targets:
+            for nxt in march(frame, cur, target, factor, prev):
+                prev, cur = cur, nxt
+            out[target] = cur
+    except BranchLost as exc:
+        exc.states = out
+        raise
     return out
