@@ -73,3 +73,22 @@ def fd_gradient(energy, x, theta, h=1e-6):
         tm[j] -= h
         gt[j] = (energy(x, tp) - energy(x, tm)) / (2 * h)
     return gx, gt
+
+
+def fluid_force_and_torque(s, y):
+    """What a free cell ``s`` (a swimmer system) at ``y`` exerts on the fluid, in total:
+    ``(force, torque, force scale, torque scale)``: blob forces + bead forces + bond torques,
+    the scales the sums of their magnitudes (a force- and torque-free cell: the totals are
+    round-off of those)."""
+    info = s.forces(y, s.frames0)
+    _, _, lam = s.body_velocity(y, info.G)
+    x, _, _ = s.unpack(y)
+    xf = x[s.free_beads]
+    F = info.G[s.sl_x].reshape(-1, 3)
+    tau = info.G[s.sl_th]
+    bf = s.bond_first[s.free_bonds]
+    t = (x[bf + 1] - x[bf]) / np.linalg.norm(x[bf + 1] - x[bf], axis=1)[:, None]
+    L = lam.reshape(-1, 3)
+    force = F.sum(axis=0) + L.sum(axis=0)
+    torque = np.cross(xf, F).sum(axis=0) + tau @ t + np.cross(s.blobs, L).sum(axis=0)
+    return force, torque, np.abs(F).sum(), np.abs(np.cross(xf, F)).sum() + np.abs(tau).sum()

@@ -125,18 +125,10 @@ def test_a_torque_motor_refuses_a_phase_speed_in_a_flagellums_protocol():
 def test_the_config_file_takes_a_flagellums_protocol(tmp_path):
     from flagwrap.io.config import load_config
 
+    from conftest import tiny_toml
+
     p = tmp_path / "c.toml"
-    p.write_text("""
-[filament]
-length = 0.4
-helix_radius = 0.03
-turns = 2
-cross_section_radius = 0.0015
-youngs_modulus = 1.5e6
-n_beads = 21
-[motor]
-machin = 283
-protocol = [{ direction = "ccw", turns = 1 }, { direction = "cw", turns = 1 }]
+    p.write_text(tiny_toml(ccw=1, cw=1) + """
 [body]
 enabled = false
 [[flagellum]]
