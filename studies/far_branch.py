@@ -11,10 +11,15 @@ or six beads rest just inside the body's contact range (distance 7.483e-3 L agai
 cut-off 7.5e-3). Followed down, the leading eigenvalue stays at -0.59..-0.63 to M = 628
 (where the leading real pair turns complex, -0.62 +- 0.05i) and jumps to +0.34 (real)
 between M = 622.8 and 620.6, where one bead leaves the contact range (6 -> 5), with dp/ds
-still negative (no fold); the corrector then stalls at M = 618.8. Open: whether that jump
-is the branch's (a contact event ending the far branch at M ~ 620, close to the whirl's
-Hopf at 616.7) or the method's (a non-smooth Jacobian at the contact edge), and how it fits
-the time-domain far states down to M = 480 (issue 29).
+still negative (no fold); the corrector then stalls at M = 618.8. The jump is the states'
+own, not the Jacobian's: at M = 624.9, 622.8 and 620.6 the frame's Jacobian agrees with
+central differences of the velocity to 1e-10 (relative), and so do their leading
+eigenvalues. The contact law's stiffness falls to zero over the last ~2e-5 L before the
+cut-off (U ~ (d_c - d)^3 there, with the WCA stiffness k ~ 1e8 in core units), so a bead
+leaving the contact range takes a large stiffness away within a few steps in M: a grazing
+event, not a smooth fold, near M ~ 621 (the whirl's Hopf: 616.7). Open: how this fits the
+time-domain far states down to M = 480 (other contact sets?), and what the branch does
+past the event (issue 29).
 
 Steady branches other than the whirl, followed through their folds (issue 29).
 
