@@ -397,8 +397,9 @@ class Simulation:
             # step (then the state is appended); a second one lands mid-step, where the state
             # may be half-updated, so it is not appended (at most save_every of motion lost)
             traj.status = "failed"
-            traj.message = f"t/T={t / TWO_PI:.6g}: interrupted (SIGINT / Ctrl-C)"
-            raise RunInterrupted(traj) from None  # (finally: wall time, frames, progress bar)
+            traj.message = f"t/T={t / TWO_PI:.6g}: interrupted ({interrupted.why})"
+            raise RunInterrupted(traj, interrupted.signame) from None  # (finally: wall time,
+            # frames, progress bar)
         finally:
             interrupted.restore()
             if bar is not None:
@@ -408,9 +409,9 @@ class Simulation:
         if interrupted():
             # the Ctrl-C came during the last step, or one a guard stopped: the run ended by
             # itself, but the caller asked to stop (a sweep must not go on to the next case)
-            note = "interrupted (SIGINT / Ctrl-C) during the last step"
+            note = f"interrupted ({interrupted.why}) during the last step"
             traj.message = f"{traj.message}; {note}" if traj.message else note
-            raise RunInterrupted(traj)
+            raise RunInterrupted(traj, interrupted.signame)
         return traj
 
 
@@ -436,48 +437,64 @@ class _Stop(Exception):
 
 
 class _deferred_sigint:
-    """Turn the first SIGINT during a run into a flag the time loop checks between steps.
+    """Turn the first SIGINT or SIGTERM during a run into a flag the time loop checks between
+    steps (``signame`` says which came).
 
     Why: a KeyboardInterrupt raised inside a numba kernel (or while numba loads one from its
     cache) surfaces as a ``SystemError``, not a KeyboardInterrupt, so the run would die with a
-    traceback instead of keeping its frames. The handler puts the previous one back, so a second
-    Ctrl-C interrupts at once (a step can take seconds at large N). Installed only in the main
-    thread (Python allows signal handlers nowhere else); elsewhere the flag stays down.
+    traceback instead of keeping its frames; SIGTERM (what ``timeout`` and batch schedulers
+    send) would kill it without a word. The handler puts the previous ones back, so a second
+    signal acts at once (a step can take seconds at large N). Installed only in the main
+    thread (Python allows signal handlers nowhere else) and only over the default handlers
+    (a test runner or a GUI that owns a signal keeps it); elsewhere the flag stays down.
     """
+
+    SIGNALS = {"SIGINT": signal.default_int_handler, "SIGTERM": signal.SIG_DFL}
 
     def __init__(self):
         self.flag = False
-        self.previous = None
-        if threading.current_thread() is threading.main_thread():
-            self.previous = signal.getsignal(signal.SIGINT)
-            if self.previous is not signal.default_int_handler:
-                self.previous = None  # someone else owns SIGINT (a test runner, a GUI): leave it
-                return
+        self.signame = ""
+        self.previous = {}
+        if threading.current_thread() is not threading.main_thread():
+            return
+        for name, default in self.SIGNALS.items():
+            sig = getattr(signal, name)
+            if signal.getsignal(sig) is not default:
+                continue  # someone else owns it: leave it
             try:
-                signal.signal(signal.SIGINT, self._handle)
+                signal.signal(sig, self._handle)
             except ValueError:  # the main thread of a sub-interpreter may not set handlers
-                self.previous = None
+                continue
+            self.previous[sig] = default
 
     def _handle(self, signum, frame):
         self.flag = True
+        self.signame = signal.Signals(signum).name
         self.restore()
 
     def restore(self):
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
-            self.previous = None
+        for sig, handler in self.previous.items():
+            signal.signal(sig, handler)
+        self.previous = {}
 
     def __call__(self) -> bool:
         return self.flag
 
+    @property
+    def why(self) -> str:
+        return "SIGTERM" if self.signame == "SIGTERM" else "SIGINT / Ctrl-C"
+
 
 class RunInterrupted(KeyboardInterrupt):
-    """Ctrl-C during :meth:`Simulation.run`; ``.trajectory`` holds the frames computed so far
-    (status "failed", message naming the time), e.g. for ``write_run``."""
+    """Ctrl-C (SIGINT) or SIGTERM during :meth:`Simulation.run`; ``.trajectory`` holds the
+    frames computed so far (status "failed", message naming the time and the signal), e.g.
+    for ``write_run``; ``.signame`` which signal ("SIGINT", "SIGTERM"; "" for a
+    KeyboardInterrupt raised otherwise)."""
 
-    def __init__(self, trajectory):
+    def __init__(self, trajectory, signame: str = ""):
         super().__init__(trajectory.message)
         self.trajectory = trajectory
+        self.signame = signame
 
 
 def make_system(config):

@@ -12,6 +12,7 @@ import os
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -201,36 +202,58 @@ def test_resource_guards_name_the_inputs(tmp_path):
     assert r.returncode == 2 and "numerics.save_every" in r.stderr and "Traceback" not in r.stderr
 
 
-def test_ctrl_c_keeps_a_readable_partial_run_file(tmp_path):
+@pytest.mark.parametrize("signame, code, said", [("SIGINT", 130, r"SIGINT / Ctrl-C"),
+                                                  ("SIGTERM", 143, r"SIGTERM")])
+def test_ctrl_c_and_sigterm_keep_a_readable_partial_run_file(tmp_path, signame, code, said):
+    # SIGTERM is what `timeout` and batch schedulers send: treated as Ctrl-C (the partial
+    # file kept, --resume named, no lock left), exit 128 + the signal's number
     import signal
     import time
 
+    sig = getattr(signal, signame)
     cfgp = tmp_path / "long.toml"
     cfgp.write_text(tiny_toml(ccw=50, cw=50).replace("tol = 1e-3", "tol = 1e-7"))  # minutes of work
     out = tmp_path / "long.nc"
     ckpt = tmp_path / "long.ckpt.h5"
-    # SIGINT back to its default in the child: a test run started in the background (nohup,
-    # `cmd &`) inherits SIGINT ignored, and the run then rightly ignores Ctrl-C too
+    # the signal back to its default in the child: a test run started in the background
+    # (nohup, `cmd &`) inherits SIGINT ignored, and the run then rightly ignores Ctrl-C too
     proc = subprocess.Popen([sys.executable, "-m", "flagwrap.cli.main", "run", str(cfgp), "--quiet",
                              "-o", str(out), "--checkpoint", str(ckpt), "--checkpoint-every", "50"],
                             stderr=subprocess.PIPE, text=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+                            preexec_fn=lambda: signal.signal(sig, signal.SIG_DFL))
     # wait until the time loop runs (a checkpoint exists), however long imports and a cold
     # numba cache take, then let it save a few frames
     t0 = time.monotonic()
     while not ckpt.exists() and proc.poll() is None and time.monotonic() - t0 < 300:
         time.sleep(0.2)
     time.sleep(2)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     # generous: the step in flight, the last frame and the partial file; on a loaded 2-core
     # machine (CI beside other jobs) 60 s was once not enough
     _, err = proc.communicate(timeout=300)
-    assert proc.returncode == 130, err
+    assert proc.returncode == code, err
     assert "Traceback" not in err
-    assert re.search(r"run stopped: t/T=[0-9.e-]+: interrupted \(SIGINT / Ctrl-C\) \(partial output kept", err), err
+    assert re.search(rf"run stopped: t/T=[0-9.e-]+: interrupted \({said}\) \(partial output kept"
+                     r".*--resume continues", err), err
     ds = read_run(out)
     assert ds.attrs["status"] == "failed" and "interrupted" in ds.attrs["message"]
     assert len(ds["time"]) >= 1 and np.all(np.isfinite(ds["position"].values))
+    assert not list(tmp_path.glob("*.lock"))  # released and removed
+    assert ckpt.exists()
+
+
+def test_a_rerun_without_resume_says_a_checkpoint_exists_and_a_stale_lock_is_taken_over(tmp_path):
+    cfgp = tmp_path / "t.toml"
+    cfgp.write_text(tiny_toml(ccw=0.05, cw=0.05))
+    out = tmp_path / "t.nc"
+    Path(f"{out}.ckpt.h5").write_bytes(b"an earlier run's")
+    Path(f"{out}.lock").write_text("")  # left by a killed process: nobody holds it
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "run", str(cfgp), "--quiet",
+                        "-o", str(out)], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "holds an earlier run's checkpoint; starting over (--resume continues" in r.stderr
+    assert f"{out}.lock was left by a process that is gone; taken over" in r.stderr
+    assert not list(tmp_path.glob("*.lock"))
 
 
 def _interrupting_step(sim, n_signals, after=3):

@@ -159,6 +159,9 @@ def _simulate(args, cfg, out, ckpt, resume) -> int:
     if resume is not None:
         print(f"flagwrap run: resuming from {ckpt} at t/T = {resume.t / (2 * math.pi):.4g} "
               f"({resume.n_steps} steps done)", file=sys.stderr)
+    elif ckpt is not None and ckpt.exists():
+        print(f"flagwrap run: note: {ckpt} holds an earlier run's checkpoint; starting over "
+              "(--resume continues from it instead)", file=sys.stderr)
     print(f"flagwrap run {cfg.name}: M = {cfg.machin:.4g}, Re = {cfg.reynolds:.3g}, "
           f"G = {cfg.gravity_number:.4g}{_mismatch(cfg)}, "
           f"omega/omega_c (scaling) = {cfg.omega_ratio_scaling:.3g}, N = {cfg.filament.n_beads}, "
@@ -180,7 +183,7 @@ def _simulate(args, cfg, out, ckpt, resume) -> int:
         print(f"flagwrap run: run stopped: {stop.trajectory.message} (partial output kept in "
               f"{target}{'; --resume continues from the last checkpoint' if ckpt is not None else ''}"
               f"{f'; the completed {out} is unchanged' if target != out else ''})", file=sys.stderr)
-        return 130
+        return 143 if stop.signame == "SIGTERM" else 130  # 128 + the signal's number
     if traj.ok:
         write_or_rescue(lambda p: write_run(traj, p), out, "run file")
     else:

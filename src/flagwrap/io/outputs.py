@@ -88,12 +88,18 @@ def output_lock(*paths):
                 continue
             lock_path = Path(f"{p}.lock")
             lock_path.parent.mkdir(parents=True, exist_ok=True)
+            stale = lock_path.exists()
             lock = FileLock(str(lock_path), timeout=0)
             try:
                 lock.acquire()
             except Timeout:
                 raise UserInputError(f"another flagwrap process is writing {p} (it holds {lock_path}); "
                                      "wait for it to finish or choose another output") from None
+            if stale:  # the file was there but no process held it: one that was killed
+                import sys
+
+                print(f"flagwrap: note: {lock_path} was left by a process that is gone; taken over",
+                      file=sys.stderr)
             held.append((lock, lock_path))
         yield
     finally:
