@@ -12,7 +12,7 @@ when complete) analysed by ``flagwrap analyze``:
 * ``single``: one flagellum at the pole (the config without its [[flagellum]] tables);
 * ``bundleN``: N flagella at the config's polar angle, spread evenly in azimuth;
 * ``equivN``: the paper's reduction, one flagellum at the pole with Young's modulus N E, so
-  bending and twist stiffness N B_1, N C_1 (seed SI: "B_n = n B_1").
+  bending and twist stiffness N B_1, N C_1 (the paper's SI: "B_n = n B_1").
 
 Prints one JSON line per case: the verdict (the first flagellum to buckle), t_c, final
 state and winding, the bundle's separation and phase lags over the last turn, the swimming
