@@ -53,3 +53,25 @@ def test_truncated_run_file_is_reported(tmp_path):
     p.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
     with pytest.raises(UserInputError, match="not a readable run file"):
         read_run(p)
+
+
+def test_turns_shortens_the_protocol_and_dry_run_runs_nothing(tmp_path, capsys):
+    cfgp = tmp_path / "tiny.toml"
+    cfgp.write_text(TINY)
+    out = tmp_path / "short.nc"
+    assert main(["run", str(cfgp), "-o", str(out), "--quiet", "--turns", "0.1", "0.05"]) == 0
+    ds = read_run(out)
+    np.testing.assert_allclose(ds["turns"].values[-1], 0.15, rtol=1e-9)
+    assert [(p.direction, p.turns) for p in config_of(ds).motor.protocol] == [("ccw", 0.1),
+                                                                             ("cw", 0.05)]
+    capsys.readouterr()
+    dry = tmp_path / "dry.nc"
+    assert main(["run", str(cfgp), "-o", str(dry), "--dry-run", "--turns", "3", "0"]) == 0
+    said = capsys.readouterr().out
+    assert "(dry run)" in said and "3 motor turns" in said and "ms per step" in said
+    assert "nothing was run" in said and not dry.exists()
+    assert not list(tmp_path.glob("dry.nc*"))  # no checkpoint, no lock
+    for bad in (["0", "0"], ["-1", "2"], ["nan", "1"]):
+        assert main(["run", str(cfgp), "-o", str(dry), "--turns", *bad]) == 2
+        assert "--turns must be two numbers >= 0" in capsys.readouterr().err
+    assert not dry.exists()

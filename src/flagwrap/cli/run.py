@@ -54,10 +54,17 @@ def add_arguments(p):
     p.add_argument("--no-checkpoint", action="store_true", help="write no checkpoints")
     p.add_argument("--resume", action="store_true",
                    help="continue from the checkpoint (same config and options as the first run)")
+    p.add_argument("--turns", type=float, nargs=2, metavar=("CCW", "CW"), default=None,
+                   help="a shorter (or longer) protocol for a first try: CCW motor turns, then "
+                        "CW (0: none), instead of motor.protocol")
+    p.add_argument("--dry-run", action="store_true",
+                   help="say what the run would cost (unknowns, memory, disk, a measured time "
+                        "per step and per turn) and run nothing")
 
 
 def load(args):
     import dataclasses
+    import math
 
     from flagwrap.cases import get_case
     from flagwrap.errors import UserInputError
@@ -83,6 +90,19 @@ def load(args):
         except UserInputError as exc:  # name the option, not the config key
             raise UserInputError(str(exc).replace("initial.perturbation", "--perturb")
                                  .replace("initial.seed", "--seed")) from None
+    turns = getattr(args, "turns", None)
+    if turns is not None:
+        from flagwrap.params import Phase
+
+        ccw, cw = turns
+        if not (math.isfinite(ccw) and math.isfinite(cw) and ccw >= 0 and cw >= 0 and ccw + cw > 0):
+            raise UserInputError(f"--turns must be two numbers >= 0 (CCW CW), not both 0, got "
+                                 f"{ccw:g} {cw:g}")
+        phases = tuple(Phase(d, t) for d, t in (("ccw", ccw), ("cw", cw)) if t > 0)
+        if cfg.flagella and any(f.protocol for f in cfg.flagella):
+            raise UserInputError("--turns replaces motor.protocol, but [[flagellum]] tables have "
+                                 "their own protocols: edit them in the config instead")
+        cfg = cfg.replace(motor=dataclasses.replace(cfg.motor, protocol=phases))
     fil, con = cfg.filament, cfg.contact
     if getattr(args, "shape", None):
         fil = dataclasses.replace(fil, shape=args.shape, pitch_angle_deg=None, turns=None)
@@ -113,8 +133,10 @@ def run(args) -> int:
 
         resume = read_checkpoint(ckpt)
         check_compatible(resume, cfg, ckpt)
-    check_memory(cfg)
+    est = check_memory(cfg)
     check_disk(cfg, out, checkpoint=ckpt is not None)
+    if getattr(args, "dry_run", False):
+        return _dry_run(cfg, est, out)
     from flagwrap.io.outputs import check_output_file, output_lock
 
     check_output_file(out, "output (-o)")
@@ -128,6 +150,46 @@ def run(args) -> int:
         check_output_file(args.figure, "--figure", suffixes=figure_suffixes())
     with output_lock(out, ckpt):
         return _simulate(args, cfg, out, ckpt, resume)
+
+
+def _dry_run(cfg, est, out) -> int:
+    """Print what the run would cost and run nothing but a 20-step probe (its time per
+    step); the turns' step counts are a range measured on the paper's and the bacterial
+    examples (benchmarks/integrators.py, benchmarks/swimmer.py)."""
+    import dataclasses
+
+    from flagwrap.simulation import Simulation, make_system
+
+    n_f = max(1, len(cfg.flagella))
+    print(f"flagwrap run {cfg.name} (dry run): {n_f} flagell{'um' if n_f == 1 else 'a'} of "
+          f"{cfg.filament.n_beads} beads, {est.unknowns} unknowns, M = {cfg.machin:.4g}, "
+          f"{est.total_turns:g} motor turns, {est.n_saves:.0f} frames saved")
+    print(f"  memory ~{est.memory / 2**20:.0f} MiB (output {est.output_memory / 2**20:.0f}, "
+          f"linear algebra {est.linalg_memory / 2**20:.0f}); run file ~"
+          f"{est.file_bytes / 2**20:.1f} MiB at {out}")
+    probe = cfg.replace(numerics=dataclasses.replace(cfg.numerics, max_steps=20))
+    system = make_system(probe)
+    Simulation(probe, system=system).run()  # compiles and warms the kernels
+    tr = Simulation(probe, system=system).run()
+    per = tr.wall_time / max(tr.n_steps, 1)
+    # steps per motor turn at tol 1e-5: ~1100-1250 (Fig. 4(a) rig and free cells, CCW); two
+    # to three times that while flagella bundle, fold or wrap (docs/bundle.md)
+    lo, hi = 1000 * est.total_turns * per, 3000 * est.total_turns * per
+    tol = cfg.numerics.tol
+    print(f"  measured {per * 1e3:.1f} ms per step (20 steps); a motor turn takes ~1000-3000 "
+          f"steps at tol 1e-5 (this config: tol {tol:g}{', fewer' if tol > 1e-5 else ''}"
+          f"{', more' if tol < 1e-5 else ''}), so the run ~{_duration(lo)} to {_duration(hi)} "
+          "on this machine")
+    print("  nothing was run (drop --dry-run to run it)")
+    return 0
+
+
+def _duration(sec: float) -> str:
+    if sec < 120:
+        return f"{sec:.0f} s"
+    if sec < 7200:
+        return f"{sec / 60:.0f} min"
+    return f"{sec / 3600:.1f} h"
 
 
 def _completed_run_at(path) -> bool:
