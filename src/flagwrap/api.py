@@ -32,17 +32,15 @@ from pathlib import Path
 def load(config):
     """A :class:`~flagwrap.params.Config` from a Config, a built-in case name (``"fig4a"``,
     :data:`flagwrap.cases.CASES`) or a TOML path."""
-    from flagwrap.cases import CASES, get_case
+    from flagwrap.cases import CASES
     from flagwrap.errors import UserInputError
-    from flagwrap.io.config import load_config
+    from flagwrap.io.config import load_config_or_case
     from flagwrap.params import Config
 
     if isinstance(config, Config):
         return config
-    if isinstance(config, str) and config in CASES:
-        return get_case(config)
-    if isinstance(config, (str, Path)):
-        return load_config(config)
+    if isinstance(config, (str, Path)):  # a file of that name, else the case (as the CLI)
+        return load_config_or_case(config)
     raise UserInputError(f"config must be a Config, a case name ({', '.join(CASES)}) or a TOML "
                          f"path, got {type(config).__name__}")
 

@@ -75,3 +75,20 @@ def test_turns_shortens_the_protocol_and_dry_run_runs_nothing(tmp_path, capsys):
         assert main(["run", str(cfgp), "-o", str(dry), "--turns", *bad]) == 2
         assert "--turns must be two numbers >= 0" in capsys.readouterr().err
     assert not dry.exists()
+
+
+def test_every_command_takes_a_case_name_where_it_takes_a_config(tmp_path, capsys):
+    # issue 34: `flagwrap stability fig4a` said "config file not found" where the API took it
+    from flagwrap.io.config import load_config_or_case
+
+    assert load_config_or_case("fig4a").name == "fig4a"
+    own = tmp_path / "fig4a"  # a file of a case's name wins: it is what the user pointed at
+    own.write_text(TINY)
+    assert load_config_or_case(str(own)).filament.n_beads == 21
+    assert main(["run", "fig4a", "--dry-run", "--turns", "0.01", "0", "-o",
+                 str(tmp_path / "f.nc")]) == 0
+    assert "fig4a (dry run)" in capsys.readouterr().out
+    for cmd in (["run"], ["stability"], ["critical"]):
+        assert main([*cmd, "no-such-case"]) == 2
+        err = capsys.readouterr().err
+        assert "config file not found: no-such-case (a built-in case instead: fig4a" in err

@@ -52,10 +52,10 @@ def run(args) -> int:
     import json
 
     from flagwrap.analysis.critical import CriticalSearch, RunCache
-    from flagwrap.io.config import load_config
+    from flagwrap.io.config import load_config_or_case
 
     _check_options(args)
-    cfg = load_config(args.config)
+    cfg = load_config_or_case(args.config)
     if args.no_hi:
         import dataclasses
 

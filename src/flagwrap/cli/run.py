@@ -68,11 +68,11 @@ def load(args):
 
     from flagwrap.cases import get_case
     from flagwrap.errors import UserInputError
-    from flagwrap.io.config import load_config
+    from flagwrap.io.config import load_config_or_case
 
     if (args.config is None) == (args.case is None):
         raise UserInputError("give a config file or --case NAME (not both)")
-    cfg = load_config(args.config) if args.config else get_case(args.case)
+    cfg = load_config_or_case(args.config) if args.config else get_case(args.case)
     num = cfg.numerics
     if args.no_hi:
         num = dataclasses.replace(num, hydrodynamics=False)

@@ -90,13 +90,13 @@ def run(args) -> int:
     import json
     import sys
 
-    from flagwrap.io.config import load_config
+    from flagwrap.io.config import load_config_or_case
     from flagwrap.stability.threshold import critical_from_config, resolve_m_max
 
     check_options(args)
     if getattr(args, "sweep", False):
         return _run_sweep(args)
-    cfg = load_config(args.config)
+    cfg = load_config_or_case(args.config)
     if args.no_hi:
         cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
     m_max = resolve_m_max(cfg, args.m_start, args.m_max)

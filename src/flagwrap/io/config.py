@@ -194,6 +194,21 @@ def _flagella(tables, lf: float) -> tuple:
     return tuple(out)
 
 
+def load_config_or_case(name) -> Config:
+    """A TOML file if ``name`` is one, else the built-in case of that name
+    (:data:`flagwrap.cases.CASES`), so that every command and the API take both; neither is
+    one line naming both."""
+    from flagwrap.cases import CASES, get_case
+
+    path = Path(name)
+    if path.is_file() or str(name) not in CASES:
+        if not path.is_file():
+            raise UserInputError(f"config file not found: {path} (a built-in case instead: "
+                                 f"{', '.join(sorted(CASES))})")
+        return load_config(path)
+    return get_case(str(name))
+
+
 def load_config(path) -> Config:
     """Read a TOML config file; every problem is a one-line :class:`UserInputError`."""
     path = Path(path)
