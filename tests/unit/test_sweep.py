@@ -49,7 +49,10 @@ def fake(tmp_path, monkeypatch):
     (d / "fake_sweep_runner.py").write_text(FAKE)
     monkeypatch.syspath_prepend(str(d))
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(d), os.environ.get("PYTHONPATH", "")]))
-    return "fake_sweep_runner:run"
+    # registered by the user's environment (this process and every subprocess), never by
+    # the sweep file, which only names it
+    monkeypatch.setenv("FLAGWRAP_SWEEP_RUNNERS", "fake=fake_sweep_runner:run")
+    return "fake"
 
 
 def _spec(runner, **extra):
@@ -422,3 +425,39 @@ def test_shipped_sweeps_load_by_name_from_any_folder(tmp_path, monkeypatch):
         load_spec("fig5-nope")
     with pytest.raises(UserInputError, match="not found"):
         load_spec("some/dir/fig5-quick")
+
+
+def test_a_sweep_file_cannot_name_code_to_import(tmp_path, monkeypatch, capsys):
+    # issue 33: `runner = "module:function"` in a shared sweep file imported and ran it; now a
+    # file names a registered runner only, and nothing it names is imported
+    from flagwrap.cli.main import main
+    from flagwrap.sweep.case import RUNNERS, register_runner, runner_target
+
+    d = tmp_path / "evil"
+    d.mkdir()
+    (d / "evil_mod.py").write_text(f"open({str(tmp_path / 'ran')!r}, 'w').write('x')\n"
+                                   "def run(cfg, path):\n    return {{}}\n")
+    monkeypatch.syspath_prepend(str(d))
+    monkeypatch.delenv("FLAGWRAP_SWEEP_RUNNERS", raising=False)
+    spec = tmp_path / "s.toml"
+    for runner in ("evil_mod:run", "os:system", "nope"):
+        spec.write_text(f'name = "s"\nrunner = "{runner}"\n[grid]\npsi_deg = [40.0]\nturns = [2.0]\n'
+                        "omega_ratio_scaling = [1.0]\n")
+        assert main(["sweep", str(spec), "--scheduler", "synchronous", "--dry-run",
+                     "--out", str(tmp_path / "out")]) == 2
+        err = capsys.readouterr().err
+        assert f"runner {runner!r} is not a registered case function (registered: default" in err
+    assert not (tmp_path / "ran").exists() and not (tmp_path / "out").exists()
+    # registered from Python (or the environment) by the user, a file may name it
+    monkeypatch.setitem(RUNNERS, "mine", "evil_mod:run")
+    assert runner_target("mine") == "evil_mod:run" and runner_target(None) == RUNNERS["default"]
+    with pytest.raises(ValueError, match="module:function"):
+        register_runner("x", "no colon")
+
+
+@pytest.mark.parametrize("name", ["..", ".", "a/b", "a\\\\b", "x\\u0000y", "-x", ".hidden", ""])
+def test_a_sweep_name_is_one_folder_under_out(tmp_path, name):
+    from flagwrap.errors import UserInputError
+
+    with pytest.raises(UserInputError, match="sweep: name must be letters, digits"):
+        _spec(None, name=name)

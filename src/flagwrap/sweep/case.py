@@ -16,15 +16,55 @@ from flagwrap.sweep.store import SweepStore
 
 DEFAULT_RUNNER = "flagwrap.analysis.critical:simulate_and_analyse"
 
+#: the case functions a sweep file may name: name -> "module:function". A sweep file names
+#: one of these, never code to import (a file shared between users must not run code); the
+#: user registers more from Python (:func:`register_runner`) or in the environment that runs
+#: the command (``FLAGWRAP_SWEEP_RUNNERS="name=module:function,..."``), both theirs.
+RUNNERS = {"default": DEFAULT_RUNNER}
+
+
+def register_runner(name: str, target: str) -> None:
+    """Let sweep files name the case function ``target`` ("module:function", importable on
+    every worker) as ``runner = name``."""
+    if not (isinstance(name, str) and name.replace("-", "_").isidentifier()):
+        raise ValueError(f"runner name must be a word (letters, digits, _ or -), got {name!r}")
+    mod, sep, fn = str(target).partition(":")
+    if not (sep and mod and fn.isidentifier()):
+        raise ValueError(f"runner target must be 'module:function', got {target!r}")
+    RUNNERS[name] = str(target)
+
+
+def runner_target(name: str | None) -> str:
+    """The "module:function" of the registered runner ``name`` (None: the default); anything
+    else is refused, naming the registered ones."""
+    import os
+
+    from flagwrap.errors import UserInputError
+
+    if name is None:
+        return DEFAULT_RUNNER
+    known = dict(RUNNERS)
+    for item in filter(None, os.environ.get("FLAGWRAP_SWEEP_RUNNERS", "").split(",")):
+        k, _, v = item.partition("=")
+        known[k.strip()] = v.strip()
+    if isinstance(name, str) and name in known:
+        return known[name]
+    raise UserInputError(
+        f"sweep: runner {name!r} is not a registered case function (registered: "
+        f"{', '.join(sorted(known))}); a sweep file names one, it cannot name code to import: "
+        "register yours with flagwrap.sweep.case.register_runner or FLAGWRAP_SWEEP_RUNNERS="
+        "name=module:function")
+
 #: analysis results copied into a row (analysis.buckling.BucklingAnalysis.summary)
 RESULT_KEYS = ("state", "buckled", "waiting_time_turns", "crossing_turns", "max_height",
                "final_height", "winding_turns", "contact_fraction", "torque_peak_reduced",
                "torque_final_reduced", "run_status", "message")
 
 
-def resolve_runner(name: str | None):
-    """Import a case function given as ``"module:function"`` (None: the default)."""
-    mod, _, fn = (name or DEFAULT_RUNNER).partition(":")
+def resolve_runner(target: str | None):
+    """Import the case function ``target`` ("module:function" of a registered runner, as a
+    case carries it from :func:`runner_target`; None: the default)."""
+    mod, _, fn = (target or DEFAULT_RUNNER).partition(":")
     return getattr(importlib.import_module(mod), fn)
 
 

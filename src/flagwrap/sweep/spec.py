@@ -416,8 +416,13 @@ def spec_from_dict(data: dict, name: str = "sweep") -> SweepSpec:
         if k not in allowed:
             raise UserInputError(f"sweep: unknown key {k!r}; allowed: {', '.join(sorted(allowed))}")
     name = data.get("name", name)
-    if not isinstance(name, str) or not name or "/" in name:
-        raise UserInputError(f"sweep: name must be a non-empty string without '/', got {name!r}")
+    import re
+
+    # the name is a folder under --out: one path component, never "." or ".."
+    if not (isinstance(name, str) and re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9._-]*", name)
+            and name not in (".", "..")):
+        raise UserInputError(f"sweep: name must be letters, digits, '.', '_' or '-' (one folder "
+                             f"name under --out, not starting with '.' or '-'), got {name!r}")
     mode = data.get("mode", "grid")
     if mode not in ("grid", "boundary"):
         raise UserInputError(f"sweep: mode must be 'grid' or 'boundary', got {mode!r}")
@@ -456,8 +461,10 @@ def spec_from_dict(data: dict, name: str = "sweep") -> SweepSpec:
     if not params:
         raise UserInputError("sweep: no cases (give [grid] and/or [[cases]])")
     runner = data.get("runner")
-    if runner is not None and (not isinstance(runner, str) or ":" not in runner):
-        raise UserInputError(f"sweep: runner must be 'module:function', got {runner!r}")
+    if runner is not None:  # a registered name, carried as its "module:function" target
+        from flagwrap.sweep.case import runner_target
+
+        runner = runner_target(runner)
     cases, seen = [], set()
     for i, p in enumerate(params):
         c = _make_case(p, run, base, mode, f"sweep case {i}", runner)
