@@ -265,3 +265,42 @@ def test_buckled_stop_event_ends_the_uninterrupted_run():
     x = np.asarray(full.x)
     w = WaitingTime().compute(np.asarray(full.t) / TWO_PI, x[:, -1, 2] - x[:, 0, 2], np.asarray(full.omega))
     assert w.buckled and ev.t[-1] / TWO_PI - w.crossing_turns >= 1.0 - 1e-9
+
+
+@pytest.mark.parametrize("damage, why", [
+    (lambda t: t[: len(t) // 2], "not readable JSON"),                       # truncated
+    (lambda t: t.replace('"buckled": true', '"buckled": "maybe"'), "checksum does not match"),
+    (lambda t: '{"buckled": "maybe", "run_status": "completed"}', "buckled = 'maybe' is not a bool"),
+    (lambda t: "[1, 2]", "not a JSON object"),
+])
+def test_a_damaged_cache_entry_is_named_and_run_again_never_trusted(tmp_path, cfg, capsys,
+                                                                    damage, why):
+    # issue 33: a truncated entry gave a JSONDecodeError traceback, one holding
+    # buckled = "maybe" was trusted as buckled
+    fake = FakeRunner()
+    probe = cfg.replace(motor=cfg.motor.__class__(machin=500.0, protocol=cfg.motor.protocol))
+    cache = RunCache(tmp_path, runner=fake)
+    first = cache.run(probe)
+    assert first.buckled and not first.reused and len(fake.calls) == 1
+    key, _, js = cache.paths(probe)
+    assert cache.run(probe).reused and len(fake.calls) == 1  # a sound entry is reused
+    js.write_text(damage(js.read_text()))
+    again = RunCache(tmp_path, runner=fake).run(probe)
+    assert not again.reused and again.buckled and len(fake.calls) == 2
+    err = capsys.readouterr().err
+    assert f"cache entry {js} is damaged" in err and why in err and "running it again" in err
+    assert RunCache(tmp_path, runner=fake).run(probe).reused  # rewritten sound
+
+
+def test_an_entry_written_before_checksums_is_still_read(tmp_path, cfg):
+    import json
+
+    fake = FakeRunner()
+    cache = RunCache(tmp_path, runner=fake)
+    probe = cfg.replace(motor=cfg.motor.__class__(machin=300.0, protocol=cfg.motor.protocol))
+    _, _, js = cache.paths(probe)
+    tmp_path.mkdir(exist_ok=True)
+    js.write_text(json.dumps({"buckled": False, "state": "stable", "run_status": "completed",
+                              "waiting_time_turns": None}))
+    r = cache.run(probe)
+    assert r.reused and not r.buckled and not fake.calls

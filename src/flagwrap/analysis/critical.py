@@ -284,6 +284,51 @@ def simulate_and_analyse(cfg, path: Path, stop_after: float | None = 2.0) -> dic
     return res
 
 
+#: what a cache entry's fields must be (absent is allowed: None)
+ENTRY_TYPES = {"buckled": (bool,), "state": (str,), "run_status": (str,), "message": (str,),
+               "waiting_time_turns": (int, float), "crossing_turns": (int, float),
+               "torque_peak_reduced": (int, float)}
+
+
+def entry_text(res: dict) -> str:
+    """A cache entry: the result and the SHA-256 of its canonical JSON."""
+    import hashlib
+
+    body = json.dumps(res, sort_keys=True)
+    return json.dumps({"result": res, "sha256": hashlib.sha256(body.encode()).hexdigest()},
+                      sort_keys=True, indent=1)
+
+
+def read_entry(path) -> tuple[dict | None, str]:
+    """``(result, "")`` of a sound cache entry, ``(None, why)`` of a damaged one: unreadable or
+    not JSON, a checksum that does not match (entries written before checksums: their fields
+    alone are checked), or a field of the wrong type (``buckled = "maybe"``)."""
+    import hashlib
+
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        return None, f"not readable JSON: {exc}"
+    if not isinstance(data, dict):
+        return None, "not a JSON object"
+    if "sha256" in data:
+        res = data.get("result")
+        if not isinstance(res, dict):
+            return None, "no result"
+        body = json.dumps(res, sort_keys=True)
+        if hashlib.sha256(body.encode()).hexdigest() != data["sha256"]:
+            return None, "its checksum does not match"
+    else:
+        res = data
+    for k, types in ENTRY_TYPES.items():
+        v = res.get(k)
+        if v is not None and (not isinstance(v, types) or (bool not in types and isinstance(v, bool))):
+            return None, f"{k} = {v!r} is not a {' or '.join(t.__name__ for t in types)}"
+    if res.get("buckled") is None and res.get("state") != "failed" and "run_status" not in res:
+        return None, "no buckling verdict and no run status"
+    return res, ""
+
+
 class RunCache:
     """Directory of test runs keyed by :func:`config_key` (``<key>.nc`` + ``<key>.json``).
 
@@ -310,18 +355,25 @@ class RunCache:
         return key, self.directory / f"{key}.nc", self.directory / f"{key}.json"
 
     def run(self, cfg) -> CriticalRun:
-        """Result of ``cfg``: from ``<key>.json`` if present, else by running it."""
+        """Result of ``cfg``: from ``<key>.json`` if present and sound (:func:`read_entry`),
+        else by running it; a damaged entry is named on stderr and recomputed."""
         key, nc, js = self.paths(cfg)
-        reused = js.is_file()
-        if reused:
-            res = json.loads(js.read_text())
-        else:
+        res = None
+        if js.is_file():
+            res, why = read_entry(js)
+            if res is None:
+                import sys
+
+                print(f"flagwrap: cache entry {js} is damaged ({why}); running it again",
+                      file=sys.stderr)
+        reused = res is not None
+        if not reused:
             self.directory.mkdir(parents=True, exist_ok=True)
             res = self.runner(cfg, nc)
             self.n_simulated += 1
             res = {k: (None if isinstance(v, float) and math.isnan(v) else v)
                    for k, v in res.items() if isinstance(v, (bool, int, float, str, type(None)))}
-            text = json.dumps(res, sort_keys=True, indent=1)
+            text = entry_text(res)
             atomic_write(js, lambda tmp: tmp.write_text(text))
 
         def num(k):
