@@ -461,3 +461,32 @@ def test_a_sweep_name_is_one_folder_under_out(tmp_path, name):
 
     with pytest.raises(UserInputError, match="sweep: name must be letters, digits"):
         _spec(None, name=name)
+
+
+@pytest.mark.parametrize("damage, why", [
+    (lambda t: t[: len(t) // 2], "not readable JSON"),
+    (lambda t: t.replace('"status": "ok"', '"status": "maybe"'), "its checksum does not match"),
+    (lambda t: json.dumps({k: v for k, v in json.loads(t).items() if k not in ("key", "_sha256")}),
+     "no key"),
+    (lambda t: json.dumps({**{k: v for k, v in json.loads(t).items() if k != "_sha256"},
+                           "buckled": "maybe"}), "buckled = 'maybe' is not a bool"),
+])
+def test_a_damaged_row_is_named_left_out_and_computed_again(tmp_path, fake, capsys, damage, why):
+    # issue 33: `sweep --dry-run` and `figure fig5` crashed on a damaged or key-less row
+    from flagwrap.sweep.runner import run_sweep
+    from flagwrap.sweep.store import SweepStore
+
+    spec = _spec(fake, grid={"psi_deg": [40.0], "turns": [2.0], "omega_ratio_scaling": [1.0, 5.0]})
+    run_sweep(spec, tmp_path / "s", scheduler="synchronous")
+    store = SweepStore(tmp_path / "s")
+    rows = sorted(store.rows.glob("*.json"))
+    assert len(rows) == 2 and len(list(store.iter_rows())) == 2
+    rows[0].write_text(damage(rows[0].read_text()))
+    capsys.readouterr()
+    assert len(list(store.iter_rows())) == 1  # left out, not a crash
+    err = capsys.readouterr().err
+    assert f"{rows[0]} is damaged ({why}" in err, err
+    rep = run_sweep(spec, tmp_path / "s", scheduler="synchronous")  # computed again
+    assert (rep.skipped, rep.failed) == (1, 0)
+    capsys.readouterr()
+    assert len(list(store.iter_rows())) == 2 and "is damaged" not in capsys.readouterr().err

@@ -40,6 +40,61 @@ def write_json_atomic(obj, path) -> Path:
     return atomic_write(path, lambda tmp: tmp.write_text(text))
 
 
+#: the field of a row or boundary file holding the SHA-256 of the rest of it
+CHECKSUM = "_sha256"
+
+
+def _digest(obj: dict) -> str:
+    import hashlib
+
+    body = json.dumps({k: v for k, v in obj.items() if k != CHECKSUM}, sort_keys=True,
+                      allow_nan=False)
+    return hashlib.sha256(body.encode()).hexdigest()
+
+
+def write_checked_json(obj: dict, path) -> Path:
+    """:func:`write_json_atomic` of ``obj`` with its checksum (:func:`read_checked_json`)."""
+    obj = {k: v for k, v in obj.items() if k != CHECKSUM}
+    return write_json_atomic({**obj, CHECKSUM: _digest(obj)}, path)
+
+
+def read_checked_json(path, need=()) -> tuple[dict | None, str]:
+    """``(object, "")`` of a sound row or boundary file, ``(None, why)`` of a damaged one:
+    not readable JSON, not an object, a checksum that does not match (files written before
+    checksums have none: their fields alone are checked), or a key of ``need`` missing."""
+    try:
+        obj = json.loads(Path(path).read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        return None, f"not readable JSON: {exc}"
+    if not isinstance(obj, dict):
+        return None, "not a JSON object"
+    if CHECKSUM in obj and obj[CHECKSUM] != _digest(obj):
+        return None, "its checksum does not match"
+    missing = [k for k in need if k not in obj]
+    if missing:
+        return None, f"no {', '.join(missing)}"
+    obj.pop(CHECKSUM, None)
+    return obj, ""
+
+
+def _damaged(path, why: str) -> None:
+    import sys
+
+    print(f"flagwrap: {path} is damaged ({why}); it is left out (a rerun of the sweep "
+          "computes it again)", file=sys.stderr)
+
+
+def _row_sound(row: dict, key: str) -> str:
+    """Why ``row`` (read from ``rows/<key>.json``) cannot be trusted, or ""."""
+    if row.get("key") != key:
+        return f"key {row.get('key')!r} is not its file's {key!r}"
+    if row.get("status") not in ("ok", "failed"):
+        return f"status = {row.get('status')!r} is not 'ok' or 'failed'"
+    if row.get("buckled") is not None and not isinstance(row["buckled"], bool):
+        return f"buckled = {row['buckled']!r} is not a bool"
+    return ""
+
+
 def jsonable(obj):
     """NaN/inf -> None, numpy scalars and arrays -> Python, recursively."""
     if isinstance(obj, dict):
@@ -80,22 +135,39 @@ class SweepStore:
         return self.rows / f"{key}.json"
 
     def has_row(self, key: str) -> bool:
-        return self.row_path(key).is_file()
+        """A sound row (:meth:`read_row`): a damaged one counts as missing, so a rerun
+        computes the case again."""
+        return self.read_row(key) is not None
 
     def read_row(self, key: str) -> dict | None:
+        """The row of ``key``, ``None`` if there is none or it is damaged (named on stderr:
+        unreadable, checksum, key, status or verdict of the wrong kind)."""
         p = self.row_path(key)
-        return json.loads(p.read_text()) if p.is_file() else None
+        if not p.is_file():
+            return None
+        row, why = read_checked_json(p, need=("key", "status"))
+        why = why or _row_sound(row, key)
+        if why:
+            _damaged(p, why)
+            return None
+        return row
 
     def write_row(self, row: dict) -> Path:
-        """Write ``row`` (must hold ``key``) atomically to ``rows/<key>.json``."""
-        return write_json_atomic(jsonable(row), self.row_path(row["key"]))
+        """Write ``row`` (must hold ``key``) atomically to ``rows/<key>.json``, with its
+        checksum."""
+        return write_checked_json(jsonable(row), self.row_path(row["key"]))
 
     def read_boundary(self, gkey: str) -> dict | None:
         p = self.boundary / f"{gkey}.json"
-        return json.loads(p.read_text()) if p.is_file() else None
+        if not p.is_file():
+            return None
+        res, why = read_checked_json(p)
+        if why:
+            _damaged(p, why)
+        return res
 
     def write_boundary(self, gkey: str, result: dict) -> Path:
-        return write_json_atomic(jsonable(result), self.boundary / f"{gkey}.json")
+        return write_checked_json(jsonable(result), self.boundary / f"{gkey}.json")
 
     def clean(self) -> int:
         """Remove temporary files left by killed writers (not a live worker's: another sweep
@@ -109,12 +181,18 @@ class SweepStore:
 
     def write_manifest(self, row_keys, gkeys=()) -> Path:
         """Record the keys of the spec just run (see the module docstring)."""
-        return write_json_atomic({"rows": sorted(set(row_keys)), "boundaries": sorted(set(gkeys))},
-                                 self.manifest_path)
+        return write_checked_json({"rows": sorted(set(row_keys)),
+                                   "boundaries": sorted(set(gkeys))}, self.manifest_path)
 
     def _current(self, kind: str) -> set | None:
         p = self.manifest_path
-        return set(json.loads(p.read_text())[kind]) if p.is_file() else None
+        if not p.is_file():
+            return None
+        man, why = read_checked_json(p, need=(kind,))
+        if why or not isinstance(man[kind], list):
+            _damaged(p, why or f"{kind} is not a list")
+            return None  # every row on disk, rather than none
+        return set(man[kind])
 
     def iter_rows(self, everything: bool = False):
         """The current spec's complete rows, sorted by key (all rows on disk if
@@ -124,15 +202,18 @@ class SweepStore:
         keep = None if everything else self._current("rows")
         for p in sorted(self.rows.glob("*.json")):
             if keep is None or p.stem in keep:
-                yield json.loads(p.read_text())
+                row = self.read_row(p.stem)  # a damaged row is named and left out
+                if row is not None:
+                    yield row
 
     def boundaries(self) -> list[dict]:
         """The current spec's boundary results (see :meth:`iter_rows`)."""
         if not self.boundary.is_dir():
             return []
         keep = self._current("boundaries")
-        return [json.loads(p.read_text()) for p in sorted(self.boundary.glob("*.json"))
-                if keep is None or p.stem in keep]
+        out = [self.read_boundary(p.stem) for p in sorted(self.boundary.glob("*.json"))
+               if keep is None or p.stem in keep]
+        return [b for b in out if b is not None]
 
     def table(self, volatile: bool = True):
         """All rows as a ``pandas.DataFrame`` sorted by key (``volatile=False`` drops the
