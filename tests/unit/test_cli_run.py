@@ -92,3 +92,17 @@ def test_every_command_takes_a_case_name_where_it_takes_a_config(tmp_path, capsy
         assert main([*cmd, "no-such-case"]) == 2
         err = capsys.readouterr().err
         assert "config file not found: no-such-case (a built-in case instead: fig4a" in err
+
+
+def test_a_header_above_the_scaling_line_says_where_this_models_threshold_is(tmp_path, capsys):
+    # issue 34: `--case movie3` reads omega/omega_c = 1.25 and ends stable, unexplained
+    assert main(["run", "--case", "fig4a", "--turns", "0.01", "0", "--quiet",
+                 "-o", str(tmp_path / "a.nc")]) == 0
+    err = capsys.readouterr().err
+    assert "omega/omega_c (scaling) = 1.99 is against the paper's scaling line" in err
+    assert "flagwrap stability" in err and "docs/stability.md" in err
+    cfgp = tmp_path / "slow.toml"
+    cfgp.write_text(TINY)  # M = 100: below the line, no note
+    assert main(["run", str(cfgp), "--quiet", "--turns", "0.01", "0", "-o",
+                 str(tmp_path / "b.nc")]) == 0
+    assert "against the paper's scaling line" not in capsys.readouterr().err
