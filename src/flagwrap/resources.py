@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import math
 import os
+
+import numpy as np
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,10 +51,12 @@ class Estimate:
     linalg_memory: float
     file_bytes: float
     unknowns: int  # ny: per flagellum 3 (N - 2) bead coordinates + (N - 2) twists + its motor angle
+    blobs: int = 0  # a no-slip body's blobs (estimated from its surface and spacing)
+    blob_memory: float = 0.0
 
     @property
     def memory(self) -> float:
-        return self.output_memory + self.linalg_memory
+        return self.output_memory + self.linalg_memory + self.blob_memory
 
 
 def total_turns(config) -> float:
@@ -84,7 +88,36 @@ def estimate(config) -> Estimate:
                                     n_f * (N - 1 - AxialClamp.n_edges), n_motors=n_f).size
     dense = num.hydrodynamics and _dense_solver(num.linear_solver, ny)
     linalg = 5.0 * 8.0 * ny * ny if dense else 200.0 * 8.0 * ny
-    return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame, ny)
+    blobs, blob_mem = _blob_cost(config, ny)
+    return Estimate(turns, n_saves, frame, 3.0 * n_saves * frame, linalg, n_saves * frame, ny,
+                    blobs, blob_mem)
+
+
+def _blob_cost(config, ny: int) -> tuple[int, float]:
+    """A no-slip body's blob count (its surface over a blob's share, ``spacing^2 sqrt(3)/2``
+    on a triangular lattice) and the memory its solver needs: the direct solver's factor and
+    inverse (two ``(3 n)^2`` matrices) and the beads x blobs block, or the Krylov solver's
+    O(n) blocks."""
+    b = config.body
+    if not b.no_slip:
+        return 0, 0.0
+    from flagwrap.body.shapes import config_shape
+
+    mesh = config_shape(config).surface_mesh(48, 18)
+    if mesh is None:
+        return 0, 0.0
+    v, f = mesh
+    tri = v[f]
+    area = 0.5 * float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                      axis=1).sum())
+    sp = b.resolved_blob_spacing(config.filament.helix_radius) / config.filament.length
+    n = int(area / (sp * sp * math.sqrt(3.0) / 2.0)) + 1
+    from flagwrap.body.solver import AUTO_DIRECT_MAX
+
+    direct = b.solver == "direct" or (b.solver == "auto" and n <= AUTO_DIRECT_MAX)
+    if direct:
+        return n, 2.0 * 8.0 * (3 * n) ** 2 + 8.0 * 3 * n * ny
+    return n, 200.0 * 8.0 * 3 * n
 
 
 def _parse_bytes(text: str) -> float:
@@ -180,7 +213,13 @@ def check_memory(config, limit: float | None = None) -> Estimate:
     if est.memory <= limit:
         return est
     num, N = config.numerics, config.filament.n_beads
-    if est.output_memory >= est.linalg_memory:
+    if est.blob_memory >= max(est.output_memory, est.linalg_memory):
+        b = config.body
+        cause = (f"the no-slip body: about {est.blobs:.3g} blobs at body.blob_spacing = "
+                 f"{b.resolved_blob_spacing(config.filament.helix_radius):.3g} m need "
+                 f"{_gb(est.blob_memory)} with body.solver = {b.solver!r}; increase "
+                 "body.blob_spacing (default R_cell / 3) or use body.solver = \"krylov\"")
+    elif est.output_memory >= est.linalg_memory:
         cause = (f"the output: {est.n_saves:.4g} saved frames (motor.protocol turns "
                  f"{est.total_turns:.4g} / numerics.save_every {num.save_every:g}) of "
                  f"filament.n_beads={N} beads need {_gb(est.output_memory)}; shorten "

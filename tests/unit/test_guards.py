@@ -381,3 +381,29 @@ def test_the_start_contact_hint_is_not_given_for_budget_stops():
     d["numerics"]["max_steps"] = 1
     traj = simulate(config_from_dict(d))
     assert "max_steps=1" in traj.message and "contact range" not in traj.message
+
+
+def test_the_estimate_prices_a_no_slip_body_and_names_its_spacing():
+    # a direct blob solver holds its factor and inverse, two (3 n)^2 matrices: a body of
+    # ~1500 blobs costs ~0.3 GB, which the memory check must count (and name) before any work
+    import dataclasses
+
+    from flagwrap.body.multiblob import cell_body_blobs
+    from flagwrap.errors import UserInputError
+    from flagwrap.io.config import load_config
+    from flagwrap.resources import check_memory, estimate
+
+    cfg = load_config(Path(__file__).parents[2] / "examples" / "s_putrefaciens.toml")
+    est = estimate(cfg)
+    n = len(cell_body_blobs(cfg)[0])
+    # a triangular lattice over the surface: an upper estimate of the ring-placed blobs
+    assert n <= est.blobs <= 1.4 * n
+    assert est.blob_memory >= 2 * 8 * (3 * n) ** 2
+    fine = cfg.replace(body=dataclasses.replace(cfg.body, solver="direct",
+                                                blob_spacing=0.4 * cfg.body.resolved_blob_spacing(
+                                                    cfg.filament.helix_radius)))
+    with pytest.raises(UserInputError, match=r"the no-slip body: about .* blobs at "
+                                             r"body.blob_spacing = .* body.solver = 'direct'"):
+        check_memory(fine, limit=0.5 * estimate(fine).blob_memory)
+    krylov = fine.replace(body=dataclasses.replace(fine.body, solver="krylov"))
+    assert estimate(krylov).blob_memory < 0.01 * estimate(fine).blob_memory
