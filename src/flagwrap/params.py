@@ -575,7 +575,11 @@ class Flagellum:
     ``motor.protocol``, which every motor without its own follows). It must last as long as
     ``motor.protocol`` (the run's length and the phases of its swimming summary), e.g. one
     motor reversing two turns after the others, or staying CCW while they reverse
-    (docs/bundle.md). The motor law (``motor.kind``) is every motor's.
+    (docs/bundle.md).
+
+    ``kind`` (with ``stall_torque`` [N m] and ``zero_load_speed`` [Hz] as ``[motor]``'s):
+    this flagellum's motor law (default: ``motor.kind`` and its torques), e.g. one
+    torque-limited motor among speed motors.
     """
 
     polar_deg: float | None = None
@@ -584,6 +588,23 @@ class Flagellum:
     anchor: tuple | None = None
     axis: tuple | None = None
     protocol: tuple | None = None
+    kind: str | None = None
+    stall_torque: float | None = None
+    zero_load_speed: float | None = None
+
+    def motor(self, motor: "Motor") -> "Motor":
+        """This flagellum's motor: ``motor`` with this table's law (validated as
+        ``[motor]``'s, the problem named ``flagellum.key``)."""
+        if self.kind is None:
+            if self.stall_torque is not None or self.zero_load_speed is not None:
+                raise UserInputError("flagellum.stall_torque and zero_load_speed need "
+                                     "flagellum.kind (the law they parametrise)")
+            return motor
+        try:
+            return dataclasses.replace(motor, kind=self.kind, stall_torque=self.stall_torque,
+                                       zero_load_speed=self.zero_load_speed)
+        except UserInputError as exc:
+            raise UserInputError(str(exc).replace("motor.", "flagellum.")) from None
 
     def __post_init__(self, where: str = "flagellum"):
         on_cap = self.polar_deg is not None or self.azimuth_deg is not None

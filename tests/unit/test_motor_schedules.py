@@ -145,3 +145,52 @@ protocol = [{ direction = "ccw", turns = 2 }]
                                        'protocol = [{ direction = "ccw" }]'))
     with pytest.raises(UserInputError, match=r"flagellum\[1\].protocol\[0\] is missing turns"):
         load_config(p)
+
+
+def test_each_flagellum_its_own_motor_law():
+    # one torque motor among speed motors ([[flagellum]] kind): far apart without HI, the
+    # speed motor's flagellum is the speed-driven single run and the torque motor's the
+    # torque-driven single run, up to the integrators' global errors, which converge with
+    # the tolerance (measured, speed / torque flagellum: 7.0e-7 / 5.3e-5 L at tol 1e-6,
+    # 9.0e-9 / 1.4e-6 at 1e-8: the torque motor's angle carries a phase error)
+    from flagwrap.system.rod_system import MixedDrives, RodSystem
+
+    L = paper_filament().length
+    tau = 2e-5  # [N m]: a load-limited rate below the speed motor's
+    errs = []
+    for tol in (1e-6, 1e-8):
+        base = _cfg(protocol=(("ccw", 0.3),), tol=tol)
+        mixed = base.replace(flagella=(
+            Flagellum(anchor=(0.0, 0.0, 0.0), axis=(0.0, 0.0, -1.0)),
+            Flagellum(anchor=(3 * L, 0.0, 0.0), axis=(0.0, 0.0, -1.0), kind="torque",
+                      stall_torque=tau)))
+        s = RodSystem(mixed)
+        assert isinstance(s.drive, MixedDrives) and s.drive.free
+        assert [d.free for d in s.drives] == [False, True]
+        two = simulate(mixed)
+        speed = simulate(base)
+        torque = simulate(base.replace(motor=dataclasses.replace(base.motor, kind="torque",
+                                                                 stall_torque=tau)))
+        assert two.ok and speed.ok and torque.ok, (two.message, torque.message)
+        x2 = np.asarray(two.x)
+        d = np.array([3.0, 0.0, 0.0])
+        errs.append((np.abs(x2[:, :21] - np.asarray(speed.x)).max(),
+                     np.abs(x2[:, 21:] - d - np.asarray(torque.x)).max()))
+        rates = np.asarray(two.motors)[:, 2:]
+        assert np.all(rates[1:, 0] == 1.0)  # the speed motor at the protocol's rate
+        assert 0.3 < rates[-1, 1] < 0.5  # the torque motor at its load (0.405 omega)
+    assert errs[0][0] < 1e-5 and errs[0][1] < 1e-4
+    assert errs[1][0] < errs[0][0] / 10 and errs[1][1] < errs[0][1] / 10
+
+
+@pytest.mark.parametrize("table, match", [
+    (dict(kind="torque"), r"flagellum\[1\].kind = 'torque' needs flagellum.stall_torque"),
+    (dict(stall_torque=1e-5), r"flagellum\[1\].stall_torque and zero_load_speed need flagellum.kind"),
+    (dict(kind="warp"), r"flagellum\[1\].kind must be one of"),
+])
+def test_a_flagellums_motor_law_is_checked_and_named(table, match):
+    L = paper_filament().length
+    with pytest.raises(UserInputError, match=match):
+        _cfg().replace(flagella=(
+            Flagellum(anchor=(0.0, 0.0, 0.0), axis=(0.0, 0.0, -1.0)),
+            Flagellum(anchor=(3 * L, 0.0, 0.0), axis=(0.0, 0.0, -1.0), **table)))

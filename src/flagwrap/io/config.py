@@ -139,7 +139,7 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
             missing = msg.split("argument")[-1].strip(": ") if "missing" in msg else msg
             raise UserInputError(f"[{section}] is missing required value(s): {missing}") from None
     if "flagellum" in data:
-        kwargs["flagella"] = _flagella(data["flagellum"], lf)
+        kwargs["flagella"] = _flagella(data["flagellum"], lf, tf)
     nm = data.get("name", name or "run")
     if not isinstance(nm, str) or not nm:
         raise UserInputError("name must be a non-empty string")
@@ -162,9 +162,10 @@ def _phases(prot, where: str) -> tuple:
     return tuple(phases)
 
 
-def _flagella(tables, lf: float) -> tuple:
+def _flagella(tables, lf: float, tf: float = 1.0) -> tuple:
     """``[[flagellum]]`` tables -> :class:`~flagwrap.params.Flagellum` s (``anchor`` in the
-    length unit ``lf``); a problem names the table, ``flagellum[k].key``."""
+    length unit ``lf``, ``stall_torque`` in the torque unit ``tf``); a problem names the
+    table, ``flagellum[k].key``."""
     if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
         raise UserInputError("flagellum must be an array of tables: [[flagellum]] per flagellum")
     if not tables:
@@ -187,6 +188,8 @@ def _flagella(tables, lf: float) -> tuple:
             t["protocol"] = _phases(t["protocol"], f"{where}.protocol")
         if isinstance(t.get("anchor"), list) and all(_is_number(c) for c in t["anchor"]):
             t["anchor"] = [c * lf for c in t["anchor"]]
+        if _is_number(t.get("stall_torque")):
+            t["stall_torque"] = t["stall_torque"] * tf
         try:
             out.append(Flagellum(**t))
         except UserInputError as exc:

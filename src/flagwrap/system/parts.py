@@ -323,6 +323,13 @@ def check_flagella(config) -> None:
 
     t_ref = Schedule(config.motor.protocol).t_end
     for k, f in enumerate(config.flagella):
+        try:
+            law = f.motor(config.motor)
+        except UserInputError as exc:
+            raise UserInputError(str(exc).replace("flagellum", f"flagellum[{k}]", 1)) from None
+        if law.kind != "speed" and config.numerics.frame != "lab":
+            raise UserInputError(f"flagellum[{k}].kind = {law.kind!r}: numerics.frame = "
+                                 f"{config.numerics.frame!r} needs speed motors")
         if f.protocol is None:
             continue
         t_k = Schedule(f.protocol).t_end
@@ -331,11 +338,11 @@ def check_flagella(config) -> None:
                 f"flagellum[{k}].protocol lasts {t_k / (2 * math.pi):.6g} reference turns, "
                 f"motor.protocol {t_ref / (2 * math.pi):.6g}: a flagellum's protocol must "
                 "last as long as the run's (sum of turns / speed)")
-        if config.motor.kind != "speed":
+        if law.kind != "speed":
             for p in f.protocol:
                 if p.direction != "stop" and p.speed != 1.0:
                     raise UserInputError(
-                        f"flagellum[{k}].protocol speed = {p.speed:g}: a {config.motor.kind} "
+                        f"flagellum[{k}].protocol speed = {p.speed:g}: a {law.kind} "
                         "motor sets its own speed; leave the phases' speed at 1")
     if len(config.flagella) > 1 and config.numerics.frame != "lab":
         raise UserInputError(f"numerics.frame = {config.numerics.frame!r} needs one flagellum on "

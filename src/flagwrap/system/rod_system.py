@@ -61,6 +61,20 @@ def motor_omega(omega, k: int) -> float:
     return omega if np.ndim(omega) == 0 else float(omega[k])
 
 
+class MixedDrives:
+    """Motors of different laws (``[[flagellum]] kind``): ``free`` when any angle is an
+    unknown; the system asks ``drives[k]`` for each motor's rate, torque and mobility."""
+
+    kind = "mixed"
+
+    def __init__(self, drives):
+        self.drives = tuple(drives)
+        self.free = any(d.free for d in self.drives)
+
+    def __getitem__(self, k):
+        return self.drives[k]
+
+
 class SeveralFilaments(TypeError):
     """A single-filament attribute (``joint``, ``rest``, ``nc`` ...) asked of a system of
     several filaments: ask ``system.parts[k]`` instead."""
@@ -104,8 +118,9 @@ class RodSystem:
         the config's ``[[flagellum]]`` tables, or one filament at the origin), each a copy
         of the config's filament and joint on its own motor of ``config.motor``'s law and
         protocol (speed motors turn together; torque motors each at its own load);
-        ``drive``: a motor law object (:mod:`flagwrap.motor.drive`'s interface; default
-        :func:`~flagwrap.motor.drive.make_drive` from ``config.motor``), every motor's."""
+        ``drive``: a motor law object (:mod:`flagwrap.motor.drive`'s interface), every
+        motor's (default: :func:`~flagwrap.motor.drive.make_drive` of ``config.motor``, or of
+        each ``[[flagellum]]`` table's own ``kind``: ``drives[k]``)."""
         self.config = config
         fil = config.filament
         L = fil.length
@@ -119,8 +134,20 @@ class RodSystem:
         self.fd_step = 6e-6 * b
         self.radius = fil.bead_radius / L  # hydrodynamics (radius in core units)
         parts = self.parts = build_parts(config, placements, x0, theta0, joint or clamp)
-        # the motor law: its angle is an unknown (layout kind "angle") when the law is free
-        self.drive = drive or make_drive(config, zeta=self.machin * parts[0].rot_drag[0])
+        # the motor laws, one per motor (a [[flagellum]] table may set its own): the angles
+        # are unknowns (layout kind "angle") when any law is free
+        if drive is not None:
+            self.drives = (drive,) * len(parts)
+        else:
+            laws = [f.motor(config.motor) for f in config.flagella]
+            if len(laws) != len(parts) or all(m == config.motor for m in laws):
+                laws = [config.motor] * len(parts)  # one law for every motor
+            self.drives = tuple(make_drive(config if m is config.motor else
+                                           config.replace(motor=m), zeta=self.machin * p.rot_drag[0])
+                                for m, p in zip(laws, parts))
+        self.drive = (self.drives[0] if len({type(d) for d in self.drives}) == 1
+                      and all(vars(d) == vars(self.drives[0]) for d in self.drives)
+                      else MixedDrives(self.drives))
         self._assemble(config)
         num = config.numerics
         self.mobility = mobility or body_mobility(config, self.radius) or make_mobility(
@@ -391,8 +418,8 @@ class RodSystem:
             return omega
         if len(self.parts) == 1:
             return self.drive.rate(motor_omega(omega, 0), self.motor_force(y, info))
-        return np.array([self.drive.rate(motor_omega(omega, k), self.motor_force(y, info, k))
-                         for k in range(len(self.parts))])
+        return np.array([d.rate(motor_omega(omega, k), self.motor_force(y, info, k)) if d.free
+                         else motor_omega(omega, k) for k, d in enumerate(self.drives)])
 
     def motor_force(self, y, info: ForceInfo, motor: int = 0) -> float:
         """``G_phi = -dE/dphi`` of motor ``motor``, its filament's elastic torque on the rotor
@@ -414,7 +441,9 @@ class RodSystem:
         rows = np.zeros((len(self.parts), len(y)))
         yp = np.array(y, float)
         for motor, p in enumerate(self.parts):
-            m = self.drive.mobility(motor_omega(omega, motor))
+            if not self.drives[motor].free:  # a speed motor's row: dphi/dt = omega, zero
+                continue
+            m = self.drives[motor].mobility(motor_omega(omega, motor))
             near = [3 * k + c for k in range(min(3, p.nb)) for c in range(3)]
             near += [3 * p.nb + j for j in range(min(3, p.ne))] + [p.ny - 1]  # its own order
             if p.ymap is not None:
@@ -583,13 +612,15 @@ class RodSystem:
         ``omega`` (:func:`motor_omega`)."""
         if len(self.parts) == 1:
             return np.array([self.motor_torque(info, phi, omega)])
-        if self.drive.free:
-            if y is None:
-                raise ValueError("motor_torques: torque motors need the state y")
-            return np.array([self.drive.torque(
-                self.drive.rate(motor_omega(omega, k), self.motor_force(y, info, k)),
-                motor_omega(omega, k)) for k in range(len(self.parts))])
-        return np.array([p.joint.generalized_force(y[self.i_phi + k] if y is not None else phi,
-                                                   info.grad_x[p.beads], info.grad_theta[p.bonds])
-                         + self.machin * p.rot_drag[0] * motor_omega(omega, k)
-                         for k, p in enumerate(self.parts)])
+        if self.drive.free and y is None:
+            raise ValueError("motor_torques: torque motors need the state y")
+        out = np.empty(len(self.parts))
+        for k, (p, d) in enumerate(zip(self.parts, self.drives)):
+            w = motor_omega(omega, k)
+            if d.free:
+                out[k] = d.torque(d.rate(w, self.motor_force(y, info, k)), w)
+            else:
+                out[k] = (p.joint.generalized_force(y[self.i_phi + k] if y is not None else phi,
+                                                    info.grad_x[p.beads], info.grad_theta[p.bonds])
+                          + self.machin * p.rot_drag[0] * w)
+        return out
