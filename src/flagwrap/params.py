@@ -28,6 +28,7 @@ PAPER_MC_PREFACTOR = 0.06
 #: bound (the paper's N = 61 helix has b = 4.4 a; coarse test chains up to ~70 a)
 MIN_SLENDERNESS = 10.0
 MAX_BOND_OVER_RADIUS = 100.0
+HYDRODYNAMIC_MODELS = ("spheres", "tube")
 #: the cell body is wider than the filament and not absurdly larger than it:
 #: 2 a < R_cell <= 10 L
 MAX_BODY_OVER_LENGTH = 10.0
@@ -83,6 +84,14 @@ class Filament:
         is the dimensionless buoyancy ``G`` (docs/gravity.md).
     hydrodynamic_radius : float or None
         bead radius used in the mobility [m]; ``None`` means ``a`` (the paper's choice).
+    hydrodynamic_model : {"spheres", "tube"}
+        ``"spheres"`` (default, the paper's): RPY spheres of radius ``hydrodynamic_radius``,
+        each with the spin drag ``8 pi eta a_h^3``. ``"tube"``: the chain matched to a slender
+        tube of radius ``a`` at its spacing (:mod:`flagwrap.hydrodynamics.tube`: bead radius
+        from the normal drag, a tangential self term from the axial drag, spin drag
+        ``4 pi eta a^2`` per length); needs ``b >= 2.51 a`` and hydrodynamic interactions,
+        and no ``hydrodynamic_radius``. The spheres at ``b ~ 6.5 a`` propel ~40 % too weakly
+        (docs/bacterium.md, "The chain matched to a tube").
     stretch_stiffness : float
         bond spring constant in units of ``A / b^3`` (default 1000: axial strain ~ F b^2/(1000 A)).
     shape : {"helix", "straight"}
@@ -106,6 +115,7 @@ class Filament:
     density: float | None = None
     hydrodynamic_radius: float | None = None
     stretch_stiffness: float = 1000.0
+    hydrodynamic_model: str = "spheres"
     density_mismatch: float | None = None
     shape: str = "helix"
 
@@ -188,6 +198,24 @@ class Filament:
                     f"filament.hydrodynamic_radius={ah:g} m must be < helix_radius={R:g} m"
                 )
         _positive("filament.stretch_stiffness", self.stretch_stiffness, "(units of A/b^3)")
+        if self.hydrodynamic_model not in HYDRODYNAMIC_MODELS:
+            raise UserInputError(f"filament.hydrodynamic_model must be one of "
+                                 f"{', '.join(map(repr, HYDRODYNAMIC_MODELS))}, got "
+                                 f"{self.hydrodynamic_model!r}")
+        if self.hydrodynamic_model == "tube":
+            from flagwrap.hydrodynamics.tube import TUBE_MIN_BOND
+
+            if self.hydrodynamic_radius is not None:
+                raise UserInputError(
+                    "filament.hydrodynamic_radius cannot be set with hydrodynamic_model = "
+                    "'tube' (the tube model derives the bead radius from a and the bond)")
+            b = L / (self.n_beads - 1)
+            if b < TUBE_MIN_BOND * a:
+                nmax = math.floor(L / (TUBE_MIN_BOND * a)) + 1
+                raise UserInputError(
+                    f"filament.hydrodynamic_model = 'tube' needs a bond L/(n_beads - 1) >= "
+                    f"{TUBE_MIN_BOND:.3f} cross_section_radius (the matched beads would overlap), "
+                    f"got {b / a:.3g} a: n_beads <= {nmax}, or hydrodynamic_model = 'spheres'")
         if L < MIN_SLENDERNESS * a:
             raise UserInputError(
                 f"filament.length={L:g} m is {L / a:.3g} x cross_section_radius={a:g} m; a Kirchhoff "
@@ -230,8 +258,29 @@ class Filament:
 
     @property
     def bead_radius(self) -> float:
-        """Hydrodynamic bead radius [m]."""
+        """Hydrodynamic bead radius [m] (the tube model's matched ``a_h``)."""
+        if self.hydrodynamic_model == "tube":
+            return self._tube.bead_radius
         return self.hydrodynamic_radius or self.cross_section_radius
+
+    @property
+    def _tube(self):
+        from flagwrap.hydrodynamics.tube import tube_chain
+
+        return tube_chain(self.cross_section_radius, self.bond_length)
+
+    @property
+    def tube_kappa(self) -> float:
+        """The tangential self-mobility factor of the tube model (0 for spheres)."""
+        return self._tube.kappa if self.hydrodynamic_model == "tube" else 0.0
+
+    @property
+    def bead_spin_drag(self) -> float:
+        """Spin drag of one bead over viscosity [m^3]: ``8 pi a_h^3`` (spheres) or the
+        tube's ``4 pi a^2 b`` (its drag per length over one bond)."""
+        if self.hydrodynamic_model == "tube":
+            return 4.0 * math.pi * self.cross_section_radius**2 * self.bond_length
+        return 8.0 * math.pi * self.bead_radius**3
 
     @property
     def curvature0(self) -> float:
@@ -914,6 +963,10 @@ class Config:
             from flagwrap.system.parts import check_flagella
 
             check_flagella(self)
+        if fil.hydrodynamic_model == "tube" and not self.numerics.hydrodynamics:
+            raise UserInputError("filament.hydrodynamic_model = 'tube' needs numerics."
+                                 "hydrodynamics = true (it is matched with the chain's "
+                                 "interactions); without them use 'spheres'")
         if self.body.no_slip or self.body.free:
             self._check_surface_body()
         if self.motor.kind != "speed":

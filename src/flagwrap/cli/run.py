@@ -227,7 +227,8 @@ def _simulate(args, cfg, out, ckpt, resume) -> int:
     print(f"flagwrap run {cfg.name}: M = {cfg.machin:.4g}, Re = {cfg.reynolds:.3g}, "
           f"G = {cfg.gravity_number:.4g}{_mismatch(cfg)}, "
           f"omega/omega_c (scaling) = {cfg.omega_ratio_scaling:.3g}, N = {cfg.filament.n_beads}, "
-          f"HI {'on' if cfg.numerics.hydrodynamics else 'off'}", file=sys.stderr)
+          f"HI {'on' if cfg.numerics.hydrodynamics else 'off'}{_bead_model(cfg)}", file=sys.stderr)
+    _weak_chain_note(cfg)
     if cfg.filament.shape == "helix" and cfg.omega_ratio_scaling > 1.0:
         # the paper's scaling line is not this model's threshold (docs/stability.md): a
         # header that reads "above threshold" must not promise a buckling run
@@ -273,6 +274,34 @@ def _simulate(args, cfg, out, ckpt, resume) -> int:
               f"{f'; the completed {out} is unchanged' if out_written != out else ''})", file=sys.stderr)
         return 1
     return 0
+
+
+def _bead_model(cfg) -> str:
+    """The header's word on the beads: the tube model's matched radius (issue 35)."""
+    fil = cfg.filament
+    if fil.hydrodynamic_model == "tube":
+        return (f" (beads matched to a tube of radius a: a_h = "
+                f"{fil.bead_radius / fil.cross_section_radius:.3g} a, kappa = {fil.tube_kappa:.3g})")
+    return ""
+
+
+def _weak_chain_note(cfg) -> None:
+    """A free swimmer on sphere beads much thinner, hydrodynamically, than the filament: its
+    speeds and torques are low by tens of per cent (docs/bacterium.md)."""
+    from flagwrap.theory.slender_body import chain_effective_radii
+
+    fil = cfg.filament
+    if not (cfg.body.free and cfg.numerics.hydrodynamics and fil.hydrodynamic_model == "spheres"):
+        return
+    if fil.bond_length < 2 * fil.bead_radius:
+        return  # overlapping beads: outside the formula, and not a thin chain
+    r_par, r_perp = chain_effective_radii(fil.bead_radius, fil.bond_length)
+    if r_perp < 0.5 * fil.cross_section_radius:
+        print(f"flagwrap run: note: the sphere beads at b = {fil.bond_length / fil.cross_section_radius:.3g} a "
+              f"drag like a tube of radius {r_par / fil.cross_section_radius:.2f} a along and "
+              f"{r_perp / fil.cross_section_radius:.2f} a across, so this swimmer's speed and "
+              "torques come out low by tens of per cent; filament.hydrodynamic_model = 'tube' "
+              "matches the filament (docs/bacterium.md)", file=sys.stderr)
 
 
 def _mismatch(cfg) -> str:

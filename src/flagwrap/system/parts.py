@@ -104,11 +104,13 @@ class FilamentPart:
     (``joint``, from :func:`flagwrap.joints.make_joint` on that shape). ``bond``: the
     nominal bond ``b`` [L]; ``twist``, ``stretch``: ``C/A`` and the stretching stiffness
     [A/L^2 per b^3]; ``radius``: the bead's hydrodynamic radius [L]; ``gravity_number``: ``G``
-    or None (no buoyancy).
+    or None (no buoyancy); ``spin_drag``: a bead's spin drag over viscosity [L^3] (default
+    ``8 pi radius^3``, a sphere's; the tube model's ``4 pi a^2 b``).
     """
 
     def __init__(self, x0, theta0, joint, *, bond: float, twist: float, stretch: float,
-                 radius: float, gravity_number=None, name: str = "flagellum"):
+                 radius: float, gravity_number=None, name: str = "flagellum",
+                 spin_drag: float | None = None):
         self.name = str(name)
         self.x0 = np.asarray(x0, float)
         self.theta0 = np.asarray(theta0, float)
@@ -125,7 +127,8 @@ class FilamentPart:
         w = np.ones(N - 1)
         w[0] += 0.5
         w[-1] += 0.5
-        self.rot_drag = 8.0 * math.pi * radius**3 * w  # geometric; times M gives core drag
+        spin = 8.0 * math.pi * radius**3 if spin_drag is None else float(spin_drag)
+        self.rot_drag = spin * w  # geometric; times M gives core drag
         # gravity/buoyancy: force per bead (core units) along +z, G l / L for a bead carrying
         # contour l (half a bond at the ends): units.gravity_number
         self.gravity = np.zeros((N, 3))
@@ -255,6 +258,7 @@ def build_parts(config, placements=None, x0=None, theta0=None, joint=None) -> li
         parts.append(FilamentPart(
             xk, thk, jk, bond=b, twist=fil.twist_modulus / fil.bending_modulus,
             stretch=fil.stretch_stiffness / b**3, radius=fil.bead_radius / L,
+            spin_drag=(fil.bead_spin_drag / L**3 if fil.hydrodynamic_model == "tube" else None),
             gravity_number=config.gravity_number if fil.density is not None else None,
             name=f"flagellum{k}"))
     return parts

@@ -33,6 +33,7 @@ from flagwrap.system import kernels as SK
 from flagwrap.body.cell_body import BodyContact, NoBody, ShapeContact, body_mobility
 from flagwrap.elasticity.rod import Frames
 from flagwrap.hydrodynamics.mobility import make_mobility
+from flagwrap.hydrodynamics.tube import TubeMobility
 from flagwrap.motor.drive import make_drive
 from flagwrap.motor.protocol import motor_schedule
 from flagwrap.system.layout import DofLayout
@@ -153,6 +154,11 @@ class RodSystem:
         self.mobility = mobility or body_mobility(config, self.radius) or make_mobility(
             num.hydrodynamics, self.radius, backend=num.mobility_backend,
             n=self.N, threads=num.threads, fmm_eps=num.mobility_tol)
+        if fil.hydrodynamic_model == "tube" and not isinstance(self.mobility, TubeMobility):
+            # each filament's free beads, in the mobility's order (flagwrap.hydrodynamics.tube)
+            ends = np.cumsum([0] + [p.nb for p in parts])
+            self.mobility = TubeMobility(self.mobility, np.stack([ends[:-1], ends[1:]], 1),
+                                         fil.tube_kappa)
         # cell body: its shape (flagwrap.body.shapes) and contact
         if config.body.enabled:
             from flagwrap.body.shapes import config_shape
