@@ -14,25 +14,6 @@
 
 from __future__ import annotations
 
-import math
-
-import numpy as np
-
-
-def free_swimmer(R_helix, sphere_radius, centre, axis=(0.0, 0.0, -1.0), omega=1.0):
-    """(speed along -axis, body rotation about axis, motor torque) of a sphere (exact drag)
-    at ``centre`` turning a rigid helix (``R_helix`` about the origin) at ``omega`` about
-    ``axis`` relative to it; force- and torque-free; no sphere-helix interaction."""
-    c = np.asarray(centre, float)
-    P = np.eye(6)
-    P[:3, 3:] = [[0, -c[2], c[1]], [c[2], 0, -c[0]], [-c[1], c[0], 0]]
-    Rh = P.T @ R_helix @ P
-    Rs = np.diag([6 * math.pi * sphere_radius] * 3 + [8 * math.pi * sphere_radius**3] * 3)
-    e = np.asarray(axis, float)
-    drive = np.concatenate([np.zeros(3), omega * e])
-    V = np.linalg.solve(Rs + Rh, -Rh @ drive)
-    return -e @ V[:3], e @ V[3:], e @ (Rh @ (V + drive))[3:]
-
 
 def main() -> int:
     from flagwrap.body.multiblob import resistance_matrix
@@ -40,7 +21,8 @@ def main() -> int:
     from flagwrap.hydrodynamics.tube import TubeMobility, tube_chain
     from flagwrap.theory.slender_body import (bead_helix, blunt_profile, chain_effective_radii,
                                               helix_centreline, johnson_resistance,
-                                              propulsion_coefficients)
+                                              propulsion_coefficients,
+                                              sphere_and_helix_swimmer)
 
     print("| b / a | spheres: r_par / a | r_perp / a | tube: a_h / a | kappa |")
     print("|---:|---:|---:|---:|---:|")
@@ -53,7 +35,7 @@ def main() -> int:
     ref = johnson_resistance(helix_centreline(L, R, P), blunt_profile(a, L, 12), n=96)
     A0, B0, D0 = propulsion_coefficients(ref)
     centre = (0.0, 0.0, 0.5 + 0.1 + L / 2)
-    s0 = free_swimmer(ref, 0.5, centre)
+    s0 = sphere_and_helix_swimmer(ref, 0.5, centre)
     print(f"\nslender-body theory (viscosity 1, um): A = {A0:.4f}, B = {B0:.5f}, D = {D0:.5f}; "
           f"swimmer per unit motor rate: speed {s0[0]:.5f} um, body {s0[1]:+.5f}, "
           f"torque {s0[2]:.4f}")
@@ -70,7 +52,7 @@ def main() -> int:
                 mob, ah = RPYMobility(a), a
             Rb = resistance_matrix(x, ah, mobility=mob.matrix(x))
             A, B, D = propulsion_coefficients(Rb)
-            s = free_swimmer(Rb, 0.5, centre)
+            s = sphere_and_helix_swimmer(Rb, 0.5, centre)
             print(f"| {N} | {b / a:.2f} | {model} | {A / A0 - 1:+.3f} | {B / B0 - 1:+.3f} | "
                   f"{D / D0 - 1:+.3f} | {s[0] / s0[0] - 1:+.3f} | {s[1] / s0[1] - 1:+.3f} | "
                   f"{s[2] / s0[2] - 1:+.3f} |")

@@ -92,3 +92,17 @@ def fluid_force_and_torque(s, y):
     force = F.sum(axis=0) + L.sum(axis=0)
     torque = np.cross(xf, F).sum(axis=0) + tau @ t + np.cross(s.blobs, L).sum(axis=0)
     return force, torque, np.abs(F).sum(), np.abs(np.cross(xf, F)).sum() + np.abs(tau).sum()
+
+
+def fd_frame_jacobian(fr, z, frames, omega):
+    """Central differences of a turning frame's velocity ``fr.velocity(z, frames, omega)``,
+    column by column (steps 1e-6 for positions, 1e-5 for angles)."""
+    f0 = fr.velocity(z, frames, omega)[0]
+    J = np.empty((len(f0), fr.n))
+    for k in range(fr.n):
+        h = 1e-6 if k < fr.n3 else 1e-5
+        zp, zm = z.copy(), z.copy()
+        zp[k] += h
+        zm[k] -= h
+        J[:, k] = (fr.velocity(zp, frames, omega)[0] - fr.velocity(zm, frames, omega)[0]) / (2 * h)
+    return J

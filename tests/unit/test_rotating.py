@@ -6,6 +6,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from conftest import fd_frame_jacobian
 from flagwrap.errors import UserInputError
 from flagwrap.io.config import load_config
 from flagwrap.params import Phase
@@ -38,13 +39,7 @@ def test_jacobian_matches_central_differences_of_the_velocity(hydrodynamics):
     f, info = fr.velocity(z, s.frames0, 400.0)
     base = info.frames
     J = fr.jacobian(z, base, 400.0, info)
-    Jb = np.empty_like(J)
-    for k in range(fr.n):
-        h = 1e-6 if k < fr.n3 else 1e-5
-        zp, zm = z.copy(), z.copy()
-        zp[k] += h
-        zm[k] -= h
-        Jb[:, k] = (fr.velocity(zp, base, 400.0)[0] - fr.velocity(zm, base, 400.0)[0]) / (2 * h)
+    Jb = fd_frame_jacobian(fr, z, base, 400.0)
     assert np.max(np.abs(J - Jb)) < 1e-7 * np.max(np.abs(J))
 
 

@@ -20,6 +20,7 @@ from flagwrap.theory.slender_body import (
     helix_centreline,
     johnson_resistance,
     propulsion_coefficients,
+    sphere_and_helix_swimmer,
     straight_chain,
 )
 
@@ -124,24 +125,6 @@ def test_sphere_helix_propels_weakly(sbt_tube):
     assert B / B0 < 0.6 and D / D0 < 0.8
 
 
-def _free_swimmer(R_helix, sphere_radius, centre, axis=(0.0, 0.0, -1.0), omega=1.0):
-    """A force- and torque-free swimmer: a sphere (exact drag) at ``centre`` and a rigid helix
-    (``R_helix`` about the origin) turned at ``omega`` about ``axis`` relative to the sphere,
-    moments about the sphere's centre; hydrodynamic interaction between the two neglected.
-    Returns (speed along -axis, body rotation about axis, motor torque about axis)."""
-    c = np.asarray(centre, float)
-    cx = np.array([[0, -c[2], c[1]], [c[2], 0, -c[0]], [-c[1], c[0], 0]])
-    P = np.eye(6)
-    P[:3, 3:] = cx  # [U_0; W] = P [U_c; W]
-    Rh = P.T @ R_helix @ P
-    Rs = np.diag([6 * math.pi * sphere_radius] * 3 + [8 * math.pi * sphere_radius**3] * 3)
-    e = np.asarray(axis, float)
-    drive = np.concatenate([np.zeros(3), omega * e])
-    V = np.linalg.solve(Rs + Rh, -Rh @ drive)
-    torque = e @ (Rh @ (V + drive))[3:]
-    return -e @ V[:3], e @ V[3:], torque
-
-
 def test_free_swimmer_against_slender_body_theory(sbt_tube):
     # a rigid helix on a free sphere (radius 0.5 um, helix from 0.1 um below its surface):
     # speed, body counter-rotation and motor torque of the tube-matched chain (101 beads)
@@ -150,14 +133,14 @@ def test_free_swimmer_against_slender_body_theory(sbt_tube):
     # differ by <= 2.7 %). Measured in docs/bacterium.md
     Rb, _ = _bead_helix_R(101, "tube")
     centre = (0.0, 0.0, 0.5 + 0.1 + L_B / 2)  # the helix is centred on the origin
-    got = _free_swimmer(Rb, 0.5, centre)
-    ref = _free_swimmer(sbt_tube, 0.5, centre)
+    got = sphere_and_helix_swimmer(Rb, 0.5, centre)
+    ref = sphere_and_helix_swimmer(sbt_tube, 0.5, centre)
     assert ref[0] != 0 and ref[1] != 0
     for g, r in zip(got, ref):
         assert g == pytest.approx(r, rel=0.03)
     # the spheres chain misses the speed by tens of per cent (the issue's -45 %)
     Rs, _ = _bead_helix_R(101, "spheres")
-    assert _free_swimmer(Rs, 0.5, centre)[0] < 0.7 * ref[0]
+    assert sphere_and_helix_swimmer(Rs, 0.5, centre)[0] < 0.7 * ref[0]
 
 
 @settings(max_examples=30, deadline=None)
@@ -270,6 +253,7 @@ def test_turning_frame_jacobian_holds_the_tube_term():
     # the turning frame's J includes the mobility's derivative (dMob[G]), here with the
     # tangent-dependent tube term: against central differences of the velocity itself, as
     # tests/unit/test_rotating.py does for the spheres (same tolerance, same steps)
+    from conftest import fd_frame_jacobian
     from flagwrap.system.rod_system import RodSystem
     from flagwrap.system.rotating import RotatingFrame
 
@@ -281,14 +265,7 @@ def test_turning_frame_jacobian_holds_the_tube_term():
     z[fr.n3:] += 0.02 * rng.standard_normal(fr.n - fr.n3)
     f, info = fr.velocity(z, s.frames0, 400.0)
     J = fr.jacobian(z, info.frames, 400.0, info)
-    Jb = np.empty_like(J)
-    for k in range(fr.n):
-        h = 1e-6 if k < fr.n3 else 1e-5
-        zp, zm = z.copy(), z.copy()
-        zp[k] += h
-        zm[k] -= h
-        Jb[:, k] = (fr.velocity(zp, info.frames, 400.0)[0]
-                    - fr.velocity(zm, info.frames, 400.0)[0]) / (2 * h)
+    Jb = fd_frame_jacobian(fr, z, info.frames, 400.0)
     assert np.max(np.abs(J - Jb)) < 1e-7 * np.max(np.abs(J))
 
 

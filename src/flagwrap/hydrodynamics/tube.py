@@ -109,8 +109,9 @@ def tube_apply_add(x, F, chains, c, out):
 
 
 @nb.njit(cache=True)
-def tube_blocks_add(x, chains, c, M):
-    """``M[3i:3i+3, 3i:3i+3] += c t_i t_i^T`` (the dense matrix)."""
+def tube_self_blocks(x, chains, c, out):
+    """``out[i] = c t_i t_i^T`` for the beads of the chains, 0 elsewhere; ``out`` (n, 3, 3)."""
+    out[:] = 0.0
     for k in range(chains.shape[0]):
         s, e = chains[k, 0], chains[k, 1]
         if e - s < 2:
@@ -119,21 +120,7 @@ def tube_blocks_add(x, chains, c, M):
             t = _tangent(x, i, s, e)
             for p in range(3):
                 for q in range(3):
-                    M[3 * i + p, 3 * i + q] += c * t[p] * t[q]
-
-
-@nb.njit(cache=True)
-def tube_self_blocks_add(x, chains, c, blocks, col):
-    """``blocks[i, col] += c t_i t_i^T`` (banded near-field blocks, ``col`` the self column)."""
-    for k in range(chains.shape[0]):
-        s, e = chains[k, 0], chains[k, 1]
-        if e - s < 2:
-            continue
-        for i in range(s, e):
-            t = _tangent(x, i, s, e)
-            for p in range(3):
-                for q in range(3):
-                    blocks[i, col, p, q] += c * t[p] * t[q]
+                    out[i, p, q] = c * t[p] * t[q]
 
 
 class TubeMobility(Mobility):
@@ -168,18 +155,28 @@ class TubeMobility(Mobility):
     def apply_single(self, x, F):
         return self._add(x, np.array(self.inner.apply_single(x, F), dtype=np.float64), F)
 
-    def matrix(self, x, out=None):
-        M = self.inner.matrix(x, out=out)
-        tube_blocks_add(np.ascontiguousarray(x, dtype=np.float64), self.chains, self._c, M)
+    def _blocks(self, x):
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        out = np.empty((len(x), 3, 3))
+        tube_self_blocks(x, self.chains, self._c, out)
+        return out
+
+    def _add_blocks(self, x, M):
+        n = len(x)
+        i = np.arange(n)
+        view = M.reshape(n, 3, n, 3)
+        if not np.shares_memory(view, M):  # pragma: no cover - inner matrices are contiguous
+            raise ValueError("TubeMobility: the inner matrix must be C-contiguous")
+        view[i, :, i, :] += self._blocks(x)
         return M
 
+    def matrix(self, x, out=None):
+        return self._add_blocks(x, self.inner.matrix(x, out=out))
+
     def _stage_matrix(self, x, out=None):
-        M = self.inner.stage_matrix(x, out=out)
-        tube_blocks_add(np.ascontiguousarray(x, dtype=np.float64), self.chains, self._c, M)
-        return M
+        return self._add_blocks(x, self.inner.stage_matrix(x, out=out))
 
     def near_field_blocks(self, x, width: int):
         out = self.inner.near_field_blocks(x, width)
-        tube_self_blocks_add(np.ascontiguousarray(x, dtype=np.float64), self.chains, self._c,
-                             out, (out.shape[1] - 1) // 2)
+        out[:, (out.shape[1] - 1) // 2] += self._blocks(x)
         return out

@@ -471,6 +471,26 @@ def compare_helix(length: float = 1.0, helix_radius: float = 0.075, turns: float
             / (helix_radius**2 + (P / (2 * math.pi)) ** 2)}
 
 
+def sphere_and_helix_swimmer(R_helix: np.ndarray, sphere_radius: float, centre,
+                             axis=(0.0, 0.0, -1.0), omega: float = 1.0):
+    """A force- and torque-free swimmer from resistance matrices (viscosity 1): a sphere of
+    ``sphere_radius`` (exact drag ``6 pi r``, ``8 pi r^3``) at ``centre`` turning a rigid
+    helix (``R_helix``, 6x6 about the origin) at ``omega`` about ``axis`` relative to itself;
+    the sphere-helix hydrodynamic interaction is left out. The helix's matrix about the
+    sphere's centre is ``P^T R P``, ``P = [[I, [c]x], [0, I]]``. Returns (speed along
+    ``-axis``, body rotation about ``axis``, motor torque about ``axis``)."""
+    c = np.asarray(centre, float)
+    P = np.eye(6)
+    P[:3, 3:] = _skew(c)
+    Rh = P.T @ np.asarray(R_helix, float) @ P
+    r = float(sphere_radius)
+    Rs = np.diag([6 * math.pi * r] * 3 + [8 * math.pi * r**3] * 3)
+    e = np.asarray(axis, float)
+    drive = np.concatenate([np.zeros(3), omega * e])
+    V = np.linalg.solve(Rs + Rh, -Rh @ drive)
+    return float(-e @ V[:3]), float(e @ V[3:]), float(e @ (Rh @ (V + drive))[3:])
+
+
 def normalised_deviation(R: np.ndarray, R_ref: np.ndarray) -> np.ndarray:
     """``|R - R_ref|_ij / sqrt(R_ref_ii R_ref_jj)``: each entry's error on the scale of the
     largest value it can take (Cauchy-Schwarz for a positive-definite matrix)."""
