@@ -197,6 +197,13 @@ class Filament:
                 raise UserInputError(
                     f"filament.hydrodynamic_radius={ah:g} m must be < helix_radius={R:g} m"
                 )
+            bond = L / (self.n_beads - 1)
+            if ah >= bond:
+                raise UserInputError(
+                    f"filament.hydrodynamic_radius={ah:g} m must be < the bond L/(n_beads - 1) = "
+                    f"{bond:g} m: a bead reaching past its neighbour's centre is a lump, not a "
+                    "chain (the RPY overlap correction keeps the mobility positive there, not the "
+                    "filament's drag)")
         _positive("filament.stretch_stiffness", self.stretch_stiffness, "(units of A/b^3)")
         if self.hydrodynamic_model not in HYDRODYNAMIC_MODELS:
             raise UserInputError(f"filament.hydrodynamic_model must be one of "

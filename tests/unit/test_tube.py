@@ -286,3 +286,16 @@ def test_free_cell_on_the_tube_mobility_is_force_and_torque_free(rng):
 def test_hydrodynamics_off_refuses_the_tube():
     with pytest.raises(UserInputError, match="needs numerics.hydrodynamics = true"):
         _tiny("hydrodynamics = false\n")
+
+
+def test_sphere_radius_past_the_neighbour_is_refused(tmp_path, capsys):
+    # bad input, by the CLI: one line naming the key, exit 2, before any work
+    from conftest import tiny_toml
+    from flagwrap.cli.main import main
+
+    cfg = tmp_path / "fat.toml"
+    cfg.write_text(tiny_toml().replace("n_beads = 21\n", "n_beads = 21\nhydrodynamic_radius = 0.025\n"))
+    assert main(["run", str(cfg), "-o", str(tmp_path / "fat.nc")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "filament.hydrodynamic_radius" in err[0] and "bond" in err[0]
+    assert not (tmp_path / "fat.nc").exists()
