@@ -299,3 +299,16 @@ def test_sphere_radius_past_the_neighbour_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "filament.hydrodynamic_radius" in err[0] and "bond" in err[0]
     assert not (tmp_path / "fat.nc").exists()
+
+
+@pytest.mark.parametrize("model, noted", [("spheres", True), ("tube", False)])
+def test_run_notes_a_free_swimmer_on_thin_sphere_beads(capsys, model, noted):
+    from flagwrap.cli.run import _bead_model, _weak_chain_note
+    from flagwrap.io.config import load_config
+
+    cfg = load_config("examples/s_putrefaciens.toml")
+    cfg = cfg.replace(filament=_filament(hydrodynamic_model=model))
+    _weak_chain_note(cfg)
+    err = capsys.readouterr().err
+    assert ("hydrodynamic_model = 'tube'" in err) == noted
+    assert ("a_h = 1.79 a" in _bead_model(cfg)) == (model == "tube")
