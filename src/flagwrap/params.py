@@ -540,15 +540,25 @@ class Clamp:
     radius ramps smoothly from 0 to ``R`` over ``lead_turns`` helical turns
     (``r = R (1 - cos(pi phi / phi_r)) / 2``). The centreline and its tangent are continuous.
 
-    Both initial shapes are stress-free. docs/model.md measures how results move between them.
+    ``lead = "connector"``: the kink lead's helix moved by ``R`` onto the body axis (the helix
+    centred on the motor axis, as a free-swimmer calculation with a rigid helix has it) and
+    reached from the anchor by a rigid radial arm of length ``R`` in the anchor plane, then the
+    clamped bond parallel to the axis. The arm and the clamped bond are held by the motor: no
+    drag, no elastic energy (hydrodynamically inactive). The filament proper and its number of
+    active beads are the kink lead's; the arm adds ``ceil(R/b)`` held beads.
+
+    All initial shapes are stress-free. docs/model.md measures how results move between them.
     """
 
     lead: str = "kink"
     lead_turns: float = 0.5
 
+    LEADS = ("kink", "ramp", "connector")
+
     def __post_init__(self):
-        if self.lead not in ("ramp", "kink"):
-            raise UserInputError(f"clamp.lead must be 'ramp' or 'kink', got {self.lead!r}")
+        if self.lead not in self.LEADS:
+            raise UserInputError(f"clamp.lead must be one of {', '.join(map(repr, self.LEADS))}, "
+                                 f"got {self.lead!r}")
         lt = _finite("clamp.lead_turns", self.lead_turns)
         if not 0.0 < lt <= 5.0:
             raise UserInputError(f"clamp.lead_turns must be in (0, 5], got {lt}")
@@ -970,6 +980,10 @@ class Config:
             from flagwrap.system.parts import check_flagella
 
             check_flagella(self)
+        if self.clamp.lead == "connector":
+            from flagwrap.system.parts import check_connector
+
+            check_connector(self)
         if fil.hydrodynamic_model == "tube" and not self.numerics.hydrodynamics:
             raise UserInputError("filament.hydrodynamic_model = 'tube' needs numerics."
                                  "hydrodynamics = true (it is matched with the chain's "

@@ -53,6 +53,10 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None,
     if ds.sizes.get("time", 0) < 2:
         raise UserInputError("run file has fewer than 2 saved frames")
     a = analysis if analysis is not None else BucklingAnalysis()
+    from flagwrap.geometry.helix import held_beads
+
+    # the beads the motor holds (a connector's arm: at the pole) are not the filament's
+    a.final.first_bead = max(a.final.first_bead, held_beads(cfg.filament, cfg.clamp))
     tq = ds["motor_torque_reduced"].values if "motor_torque_reduced" in ds.variables else None
     if "motor_torques" in ds.variables:  # several flagella: this one's motor
         tq = ds["motor_torques"].values[:, filament] * R / cfg.filament.bending_modulus

@@ -10,6 +10,8 @@ stress-free shape, so the whole initial configuration is an exact equilibrium.
 
 The paper does not print the shape of the rod next to the clamp; this is the simplest choice
 that has a vertical clamped end and a uniform helix (see docs/model.md, "Clamp geometry").
+The other leads: a radius ramp onto the axis (:func:`ramp_helix_positions`) and the same
+helix centred on the axis behind a held arm (:func:`connector_helix_positions`).
 
 Consecutive helix beads are spaced by an exact chord ``b = L / (N - 1)``, so the discrete
 contour length is exactly ``L``.
@@ -111,6 +113,40 @@ def ramp_helix_positions(length, helix_radius, pitch, n_beads, handedness="left"
     return x
 
 
+def connector_arm_bonds(helix_radius: float, bond: float) -> int:
+    """Bonds of the connector's radial arm (:func:`connector_helix_positions`): the fewest
+    whose length ``R / k`` does not exceed the filament's bond ``b``."""
+    return max(1, int(math.ceil(helix_radius / bond - 1e-9)))
+
+
+def connector_helix_positions(length, helix_radius, pitch, n_beads, handedness="left"):
+    """The helix of :func:`helix_positions` centred on the body axis and reached by a rigid arm.
+
+    Bead 0 at the anchor (the origin); ``k`` beads along a radial arm in the anchor plane to
+    ``(-R, 0, 0)`` (:func:`connector_arm_bonds`); then the ``n_beads - 1`` beads of
+    :func:`helix_positions` from its bead 1 on, moved by ``-R`` along x, so that the first of
+    them is ``(-R, 0, -b)`` below the arm's end (an axial bond of length ``b``) and the helix's
+    axis is the body axis. ``n_beads + k`` beads; the arm and the axial bond are the joint's
+    (held by the motor, no drag, no elastic energy); the filament proper is the kink lead's.
+    """
+    x = helix_positions(length, helix_radius, pitch, n_beads, handedness)
+    b = length / (int(n_beads) - 1)
+    k = connector_arm_bonds(helix_radius, b)
+    arm = np.zeros((k, 3))
+    arm[:, 0] = -helix_radius * np.arange(1, k + 1) / k
+    hel = x[1:].copy()
+    hel[:, 0] -= helix_radius
+    return np.concatenate([x[:1], arm, hel])
+
+
+def held_beads(fil, clamp=None) -> int:
+    """Beads the motor holds at the start of the filament's chain (not in the hydrodynamics):
+    2 (the clamped bond), plus the connector's arm for ``clamp.lead = "connector"``."""
+    if clamp is not None and clamp.lead == "connector" and getattr(fil, "shape", "helix") != "straight":
+        return 2 + connector_arm_bonds(fil.helix_radius, fil.bond_length)
+    return 2
+
+
 def straight_positions(length, n_beads) -> np.ndarray:
     """A straight rod of ``n_beads`` beads from the origin down the body axis (-z) [length unit
     of ``length``], bonds exactly ``length / (n_beads - 1)``."""
@@ -121,9 +157,13 @@ def straight_positions(length, n_beads) -> np.ndarray:
 
 def filament_positions(fil, clamp=None) -> np.ndarray:
     """Initial positions [m] of a :class:`flagwrap.params.Filament` with a clamp lead
-    (``fil.shape = "straight"``: a straight rod, the lead does not apply)."""
+    (``fil.shape = "straight"``: a straight rod, the lead does not apply). The connector lead
+    adds its arm's beads (:func:`held_beads`)."""
     if getattr(fil, "shape", "helix") == "straight":
         return straight_positions(fil.length, fil.n_beads)
+    if clamp is not None and clamp.lead == "connector":
+        return connector_helix_positions(fil.length, fil.helix_radius, fil.pitch, fil.n_beads,
+                                         fil.handedness)
     if clamp is not None and clamp.lead == "ramp":
         lt = clamp.lead_turns
         return ramp_helix_positions(fil.length, fil.helix_radius, fil.pitch, fil.n_beads,

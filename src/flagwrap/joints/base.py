@@ -36,6 +36,8 @@ class Joint:
     #: proper (whose angle to the motor axis is the joint's angle)
     vertex = 1
     exit_bond = 1
+    #: the motor's bond (the last one it holds), from which the joint's angle is measured
+    motor_bond = 0
     kind = "joint"
 
     def rest(self, rest):
@@ -44,14 +46,14 @@ class Joint:
     def observables(self, x, theta, m1, m2, frames, rest) -> tuple[float, float, float]:
         """``(angle [rad], bending torque [A/L], twist torque [A/L])`` at the joint.
 
-        Angle: between the motor's bond (bond 0) and :attr:`exit_bond`. Torques at
+        Angle: between the motor's bond (:attr:`motor_bond`) and :attr:`exit_bond`. Torques at
         :attr:`vertex`: ``cb |kappa - kappa_bar|`` and ``ct (m - m_bar)`` (the elastic
         kernel's terms, :mod:`flagwrap.elasticity._kernels`; at an ``angle_law`` vertex the
         curvatures in the turning-angle measure its ``kappa_bar`` is in).
         """
         i = self.vertex
         t = frames.t
-        c = float(np.clip(np.dot(t[0], t[self.exit_bond]), -1.0, 1.0))
+        c = float(np.clip(np.dot(t[self.motor_bond], t[self.exit_bond]), -1.0, 1.0))
         ta, tb = t[i - 1], t[i]
         kb = 2.0 * np.cross(ta, tb) / (1.0 + np.dot(ta, tb))
         g = turning_angle_scale(float(np.linalg.norm(kb))) if rest.angle_law[i] else 1.0

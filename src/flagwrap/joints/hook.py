@@ -42,36 +42,41 @@ class LumpedHook(AxialClamp):
     kind = "hook"
 
     def __init__(self, x0, theta0, k_bend: float, k_twist: float, axis=(0.0, 0.0, -1.0),
-                 origin=(0.0, 0.0, 0.0)):
-        super().__init__(x0, theta0, axis, origin)
+                 origin=(0.0, 0.0, 0.0), n_beads: int = 2):
+        super().__init__(x0, theta0, axis, origin, n_beads)
         if not (k_bend > 0 and k_twist > 0):
             raise ValueError("LumpedHook: k_bend and k_twist must be > 0")
         self.k_bend = float(k_bend)
         self.k_twist = float(k_twist)
-        ta = (x0[1] - x0[0]) / np.linalg.norm(x0[1] - x0[0])
-        tb = (x0[2] - x0[1]) / np.linalg.norm(x0[2] - x0[1])
+        v = self.vertex
+        ta = (x0[v] - x0[v - 1]) / np.linalg.norm(x0[v] - x0[v - 1])
+        tb = (x0[v + 1] - x0[v]) / np.linalg.norm(x0[v + 1] - x0[v])
         c = float(np.clip(ta @ tb, -1.0, 1.0))
         #: rest turning angle at the hook and the factor psi/|kb| that rescales its curvature
         self.rest_angle = float(np.arccos(c))
         self._g0 = turning_angle_scale(2.0 * np.sqrt(max(1.0 - c, 0.0) / (1.0 + c)))
 
     def rest(self, rest):
-        r = rest.with_vertex(1, cbend=self.k_bend, ctwist=self.k_twist,
-                             kbar=rest.kbar[1] * self._g0)
+        v = self.vertex
+        r = super().rest(rest).with_vertex(v, cbend=self.k_bend, ctwist=self.k_twist,
+                                           kbar=rest.kbar[v] * self._g0)
         law = r.angle_law.copy()
-        law[1] = True
+        law[v] = True
         return dataclasses.replace(r, angle_law=law)
 
 
-def insert_hook(x0: np.ndarray, theta0: np.ndarray, length: float, segments: int):
-    """``x0`` with ``segments`` bonds of ``length/segments`` inserted after bead 1, along the
-    motor's bond; the beads beyond move by ``length`` along it (their shape is unchanged)."""
-    t0 = x0[1] - x0[0]
+def insert_hook(x0: np.ndarray, theta0: np.ndarray, length: float, segments: int,
+                held: int = 2):
+    """``x0`` with ``segments`` bonds of ``length/segments`` inserted after bead ``held - 1``
+    (the motor's last held bead), along the motor's bond; the beads beyond move by ``length``
+    along it (their shape is unchanged)."""
+    m = held - 2  # the motor's bond
+    t0 = x0[m + 1] - x0[m]
     t0 = t0 / np.linalg.norm(t0)
     s = length / segments * np.arange(1, segments + 1)
-    hook = x0[1] + s[:, None] * t0
-    x = np.concatenate([x0[:2], hook, x0[2:] + length * t0])
-    theta = np.concatenate([theta0[:1], np.full(segments, theta0[0]), theta0[1:]])
+    hook = x0[m + 1] + s[:, None] * t0
+    x = np.concatenate([x0[:held], hook, x0[held:] + length * t0])
+    theta = np.concatenate([theta0[:m + 1], np.full(segments, theta0[m]), theta0[m + 1:]])
     return x, theta
 
 
@@ -85,14 +90,14 @@ class ResolvedHook(AxialClamp):
     kind = "hook"
 
     def __init__(self, x0, theta0, length, segments, bending, twist, rod_bending, rod_twist,
-                 bond, axis=(0.0, 0.0, -1.0), origin=(0.0, 0.0, 0.0)):
-        super().__init__(x0, theta0, axis, origin)
+                 bond, axis=(0.0, 0.0, -1.0), origin=(0.0, 0.0, 0.0), n_beads: int = 2):
+        super().__init__(x0, theta0, axis, origin, n_beads)
         if not (length > 0 and segments >= 2 and bending > 0 and twist > 0):
             raise ValueError("ResolvedHook: length, bending, twist > 0 and segments >= 2 needed")
         self.length, self.segments = float(length), int(segments)
         self.bending, self.twist = float(bending), float(twist)
         self.rod_bending, self.rod_twist, self.bond = float(rod_bending), float(rod_twist), float(bond)
-        self.exit_bond = self.segments + 1
+        self.exit_bond = self.vertex + self.segments
 
     def _compliances(self, modulus, rod_modulus):
         """Per-vertex ``l_i/K_i`` of vertices 1..n+1 (their sum over the hook is ``l_h/K_h``)."""
@@ -103,9 +108,10 @@ class ResolvedHook(AxialClamp):
         return c
 
     def rest(self, rest):
-        n = self.segments
+        n, v = self.segments, self.vertex
+        rest = super().rest(rest)
         cb = rest.cbend.copy()
         ct = rest.ctwist.copy()
-        cb[1:n + 2] = 1.0 / self._compliances(self.bending, self.rod_bending)
-        ct[1:n + 2] = 1.0 / self._compliances(self.twist, self.rod_twist)
+        cb[v:v + n + 1] = 1.0 / self._compliances(self.bending, self.rod_bending)
+        ct[v:v + n + 1] = 1.0 / self._compliances(self.twist, self.rod_twist)
         return dataclasses.replace(rest, cbend=cb, ctwist=ct)

@@ -378,6 +378,33 @@ def check_flagella(config) -> None:
                     "anchors: polar_deg, azimuth_deg, or turn one: spin_deg)")
 
 
+def check_connector(config) -> None:
+    """Refuse ``clamp.lead = "connector"`` where it cannot be built (one line naming the key):
+    a straight filament (no helix to centre), or an arm that enters the body (a motor axis
+    tilted from the surface normal puts the arm's plane through it)."""
+    from flagwrap.body.shapes import config_shape
+    from flagwrap.errors import UserInputError
+    from flagwrap.geometry.helix import filament_positions, held_beads
+
+    fil = config.filament
+    if fil.shape == "straight":
+        raise UserInputError("clamp.lead = 'connector' centres a helix on the motor axis; "
+                             "filament.shape = 'straight' has none (use lead = 'kink')")
+    if not config.body.enabled:
+        return
+    L, a = fil.length, fil.cross_section_radius
+    shape = config_shape(config, unit=1.0)  # metres
+    held = filament_positions(fil, config.clamp)[:held_beads(fil, config.clamp)] / L
+    for k, pl in enumerate(placements_from_config(config) or [Placement()]):
+        d = float(np.min(shape.distance(pl.apply(held) * L)))
+        if d < -0.1 * a:
+            where = f"flagellum[{k}]" if config.flagella else "the motor"
+            raise UserInputError(
+                f"clamp.lead = 'connector': the arm of {where} (length R = "
+                f"{fil.helix_radius:.3g} m, square to the motor axis) enters the body by "
+                f"{-d:.3g} m; turn the motor axis along the surface normal or use lead = 'kink'")
+
+
 def _min_segment_distance(x, z) -> float:
     """The smallest distance between a segment of chain ``x`` and one of chain ``z``."""
     from flagwrap.interactions.self_contact import segment_closest
