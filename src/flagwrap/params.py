@@ -623,6 +623,32 @@ class Joint:
 
 
 @dataclass(frozen=True)
+class Wall:
+    """A no-slip plane wall (``[[wall]]``, issue 32; docs/confinement.md): the plane through
+    ``point`` [m, length unit] with ``normal`` pointing into the fluid (any length but zero).
+    With hydrodynamics it screens the flow (the Rotne-Prager-Blake mobility,
+    :mod:`flagwrap.hydrodynamics.wall`); always it repels the filament's beads with the body's
+    contact law (``[contact]`` range, strength, potential) on their distance to the plane."""
+
+    point: tuple = (0.0, 0.0, 0.0)
+    normal: tuple = (0.0, 0.0, 1.0)
+
+    def __post_init__(self, where: str = "wall"):
+        for key in ("point", "normal"):
+            v = getattr(self, key)
+            if not (isinstance(v, (list, tuple)) and len(v) == 3):
+                raise UserInputError(f"{where}.{key} must be 3 numbers [x, y, z], got {v!r}")
+            _set(self, key, tuple(_finite(f"{where}.{key}", c) for c in v))
+        if not math.hypot(*self.normal) > 0.0:
+            raise UserInputError(f"{where}.normal must not be zero (it points into the fluid)")
+
+    @property
+    def unit_normal(self) -> np.ndarray:
+        n = np.asarray(self.normal, float)
+        return n / np.linalg.norm(n)
+
+
+@dataclass(frozen=True)
 class Flagellum:
     """Where one flagellum sits on the cell body (issue 28; ``[[flagellum]]`` tables, one per
     flagellum; docs/bundle.md). Every flagellum is a copy of ``[filament]`` on its own
@@ -934,6 +960,8 @@ class Config:
     joint: Joint = field(default_factory=Joint)
     #: one per flagellum (``[[flagellum]]``); empty: one flagellum at the pole
     flagella: tuple = ()
+    #: no-slip plane walls (``[[wall]]``); empty: free space
+    walls: tuple = ()
     name: str = "run"
 
     def __post_init__(self):
@@ -954,6 +982,10 @@ class Config:
         for k, f in enumerate(self.flagella):
             if not isinstance(f, Flagellum):
                 raise UserInputError(f"config.flagella[{k}] must be a Flagellum")
+        _set(self, "walls", tuple(self.walls))
+        for k, w in enumerate(self.walls):
+            if not isinstance(w, Wall):
+                raise UserInputError(f"config.walls[{k}] must be a Wall")
         fil = self.filament
         if fil.density_mismatch is not None:
             # resolved to a density here, where the fluid's is known (as pitch-like inputs
@@ -984,6 +1016,10 @@ class Config:
             from flagwrap.system.parts import check_connector
 
             check_connector(self)
+        if self.walls:
+            from flagwrap.system.parts import check_walls
+
+            check_walls(self)
         if fil.hydrodynamic_model == "tube" and not self.numerics.hydrodynamics:
             raise UserInputError("filament.hydrodynamic_model = 'tube' needs numerics."
                                  "hydrodynamics = true (it is matched with the chain's "
@@ -1157,6 +1193,9 @@ class Config:
         fl = d.pop("flagella", [])
         if fl:
             d["flagellum"] = fl
+        walls = d.pop("walls", [])
+        if walls:
+            d["wall"] = walls
         # pitch-like inputs are all stored after resolution; keep only pitch (canonical)
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)

@@ -159,14 +159,15 @@ class NoBody:
         return np.full(len(x), np.inf)
 
 
-def body_mobility(config, radius: float):
+def body_mobility(config, radius: float, wall=None):
     """The beads' mobility beside ``config``'s fixed no-slip body
     (:class:`~flagwrap.body.fixed_mobility.FixedBodyMobility`, bead ``radius`` in core
-    units), or ``None`` for a transparent body (the free-space mobility applies)."""
+    units; beside a ``wall`` too, :class:`~flagwrap.hydrodynamics.wall.PlaneWall`), or ``None``
+    for a transparent body (the free-space mobility applies)."""
     if not config.body.no_slip:
         return None
     from flagwrap.body.multiblob import cell_body_blobs
     from flagwrap.body.fixed_mobility import FixedBodyMobility
 
     blobs, radii = cell_body_blobs(config)
-    return FixedBodyMobility(radius, blobs, radii, solver=config.body.solver)
+    return FixedBodyMobility(radius, blobs, radii, solver=config.body.solver, wall=wall)

@@ -13,6 +13,7 @@ import numpy as np
 from flagwrap.body.solver import (DirectBlobSolver, LaggedScreening, make_blob_solver,
                                   screening_matrix)
 from flagwrap.hydrodynamics.polydisperse import rpy_cross_apply, rpy_cross_block
+from flagwrap.hydrodynamics.wall import wall_correction_apply, wall_correction_matrix
 
 
 class FixedBodyMobility:
@@ -37,23 +38,31 @@ class FixedBodyMobility:
     backend = "direct+fixed-body"
     axisymmetric = False
 
-    def __init__(self, radius: float, blobs, blob_radii, solver: str = "direct"):
+    def __init__(self, radius: float, blobs, blob_radii, solver: str = "direct", wall=None):
         from flagwrap.hydrodynamics.mobility import RPYMobility
+        from flagwrap.hydrodynamics.wall import WallMobility
 
+        self.wall = wall
         self.radius = float(radius)
         self.self_mobility = 1.0 / (6.0 * math.pi * self.radius)
         self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
         self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
                                                dtype=np.float64)
         self._free = RPYMobility(self.radius)
-        self._solver = make_blob_solver(solver, self.blobs, self.blob_radii)
+        if wall is not None:  # every block beside the plane (flagwrap.hydrodynamics.wall)
+            self._free = WallMobility(self._free, wall)
+            self.backend = "direct+fixed-body+wall"
+        self._solver = make_blob_solver(solver, self.blobs, self.blob_radii, wall)
         #: products with the beads x blobs block computed pair by pair (the Krylov blob
         #: solver's O(n) memory), not from a stored block (the direct solver's, faster)
         self.matrix_free = not isinstance(self._solver, DirectBlobSolver)
         self._lagged = LaggedScreening(self._solver, self.blobs, self._cross)
 
     def _cross(self, x):
-        return rpy_cross_block(x, self.radius, self.blobs, self.blob_radii)
+        C = rpy_cross_block(x, self.radius, self.blobs, self.blob_radii)
+        if self.wall is not None:
+            C += wall_correction_matrix(self.wall, x, self.radius, self.blobs, self.blob_radii)
+        return C
 
     def screening(self, x) -> np.ndarray:
         """``M_fb M_bb^-1 M_bf`` (3n, 3n): what the body takes off the free mobility."""
@@ -98,8 +107,12 @@ class FixedBodyMobility:
         nb, m = len(x), len(self.blobs)
         ub, ux, empty = np.empty((m, 3)), np.empty((nb, 3)), np.empty((0, 3))
         rpy_cross_apply(x, self.radius, self.blobs, self.blob_radii, empty, F, ux, ub)
+        if self.wall is not None:
+            ub += wall_correction_apply(self.wall, self.blobs, self.blob_radii, x, self.radius, F)
         lam = np.ascontiguousarray(self._solver.solve(ub.ravel()).reshape(m, 3))
         rpy_cross_apply(x, self.radius, self.blobs, self.blob_radii, lam, empty, ux, ub)
+        if self.wall is not None:
+            ux += wall_correction_apply(self.wall, x, self.radius, self.blobs, self.blob_radii, lam)
         return self._free.apply(x, F) - ux
 
     apply_single = apply

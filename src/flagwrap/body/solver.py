@@ -23,6 +23,7 @@ import scipy.linalg as sla
 from scipy.linalg.blas import dsymv as _symv
 
 from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, rpy_apply_radii
+from flagwrap.hydrodynamics.wall import wall_correction_apply, wall_correction_matrix
 
 #: most blobs for which "auto" takes the direct solver (a 1500-blob factor is 162 MB)
 AUTO_DIRECT_MAX = 1500
@@ -41,10 +42,12 @@ class DirectBlobSolver:
     kind = "direct"
     INVERSE_MAX = 1500
 
-    def __init__(self, blobs: np.ndarray, radii: np.ndarray):
+    def __init__(self, blobs: np.ndarray, radii: np.ndarray, wall=None):
         from scipy.linalg import lapack
 
         Mbb = PolydisperseRPY(radii).matrix(blobs)
+        if wall is not None:  # beside a plane wall (flagwrap.hydrodynamics.wall)
+            Mbb += wall_correction_matrix(wall, blobs, radii)
         L, info = lapack.dpotrf(Mbb, lower=1, overwrite_a=1)
         if info != 0:
             raise ValueError(f"the blob matrix is not positive definite (LAPACK info {info})")
@@ -82,9 +85,10 @@ class KrylovBlobSolver:
     kind = "krylov"
 
     def __init__(self, blobs: np.ndarray, radii: np.ndarray, rtol: float = 1e-10,
-                 block: int = 64, maxiter: int = 500):
+                 block: int = 64, maxiter: int = 500, wall=None):
         from scipy.spatial import cKDTree
 
+        self.wall = wall
         self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
         self.radii = np.ascontiguousarray(radii, dtype=np.float64)
         self.rtol, self.maxiter = float(rtol), int(maxiter)
@@ -97,13 +101,19 @@ class KrylovBlobSolver:
         self._factors = []
         for g in self._groups:
             Mg = PolydisperseRPY(self.radii[g]).matrix(np.ascontiguousarray(self.blobs[g]))
+            if wall is not None:
+                Mg += wall_correction_matrix(wall, self.blobs[g], self.radii[g])
             self._factors.append(sla.cho_factor(Mg, lower=True, check_finite=False))
         self._n = 3 * n
 
     def apply(self, v: np.ndarray) -> np.ndarray:
         """``M_bb v``, the RPY sum (no matrix)."""
         out = np.empty((len(self.blobs), 3))
-        rpy_apply_radii(self.blobs, self.radii, np.ascontiguousarray(v.reshape(-1, 3)), out)
+        v3 = np.ascontiguousarray(v.reshape(-1, 3))
+        rpy_apply_radii(self.blobs, self.radii, v3, out)
+        if self.wall is not None:
+            out += wall_correction_apply(self.wall, self.blobs, self.radii, self.blobs,
+                                         self.radii, v3)
         return out.ravel()
 
     def _precondition(self, r: np.ndarray) -> np.ndarray:
@@ -210,10 +220,13 @@ class LaggedScreening:
             self._compute(memory.reshape(-1, 3).copy())
 
 
-def make_blob_solver(kind: str, blobs, radii):
-    """The solver ``kind`` ("auto", "direct", "krylov") for these blobs."""
+def make_blob_solver(kind: str, blobs, radii, wall=None):
+    """The solver ``kind`` ("auto", "direct", "krylov") for these blobs (beside ``wall``, a
+    :class:`~flagwrap.hydrodynamics.wall.PlaneWall`, if given)."""
     if kind not in KINDS:
         raise ValueError(f"blob solver must be one of {KINDS}, got {kind!r}")
     if kind == "auto":
         kind = "direct" if len(blobs) <= AUTO_DIRECT_MAX else "krylov"
-    return DirectBlobSolver(blobs, radii) if kind == "direct" else KrylovBlobSolver(blobs, radii)
+    if kind == "direct":
+        return DirectBlobSolver(blobs, radii, wall=wall)
+    return KrylovBlobSolver(blobs, radii, wall=wall)

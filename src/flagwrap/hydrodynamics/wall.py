@@ -149,6 +149,15 @@ def wall_cross_apply(xt, at, xs, as_, Fs, ut):
         ut[i, 2] += u2
 
 
+def config_wall(config) -> PlaneWall | None:
+    """The config's ``[[wall]]`` (one; :func:`flagwrap.system.parts.check_walls`) in core
+    units, or None."""
+    if not config.walls:
+        return None
+    w, L = config.walls[0], config.filament.length
+    return PlaneWall(np.asarray(w.point, float) / L, w.unit_normal)
+
+
 def _radii(r, n) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(np.asarray(r, float), (n,)))
 

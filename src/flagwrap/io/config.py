@@ -24,7 +24,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from flagwrap.errors import UserInputError
-from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Flagellum, Fluid,
+from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Flagellum, Fluid, Wall,
                              Initial, Joint, Motor, Numerics, Phase)
 
 _SECTIONS = {
@@ -92,7 +92,7 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
     if not isinstance(data, dict):
         raise UserInputError("config must be a TOML table")
     data = dict(data)
-    allowed_top = set(_SECTIONS) | {"units", "name", "flagellum"}
+    allowed_top = set(_SECTIONS) | {"units", "name", "flagellum", "wall"}
     for key in data:
         if key not in allowed_top:
             raise UserInputError(f"unknown section or key {key!r}; allowed: {', '.join(sorted(allowed_top))}")
@@ -140,6 +140,8 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
             raise UserInputError(f"[{section}] is missing required value(s): {missing}") from None
     if "flagellum" in data:
         kwargs["flagella"] = _flagella(data["flagellum"], lf, tf)
+    if "wall" in data:
+        kwargs["walls"] = _walls(data["wall"], lf)
     nm = data.get("name", name or "run")
     if not isinstance(nm, str) or not nm:
         raise UserInputError("name must be a non-empty string")
@@ -194,6 +196,29 @@ def _flagella(tables, lf: float, tf: float = 1.0) -> tuple:
             out.append(Flagellum(**t))
         except UserInputError as exc:
             raise UserInputError(str(exc).replace("flagellum", where, 1)) from None
+    return tuple(out)
+
+
+def _walls(tables, lf: float) -> tuple:
+    """``[[wall]]`` tables -> :class:`~flagwrap.params.Wall` s (``point`` in the length unit
+    ``lf``); a problem names the table, ``wall[k].key``."""
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        raise UserInputError("wall must be an array of tables: [[wall]] per wall")
+    known = _fields(Wall)
+    out = []
+    for k, t in enumerate(tables):
+        where = f"wall[{k}]"
+        for key in t:
+            if key not in known:
+                raise UserInputError(f"unknown key {where}.{_show(key)}; allowed: "
+                                     f"{', '.join(sorted(known))}")
+        t = dict(t)
+        if isinstance(t.get("point"), list) and all(_is_number(c) for c in t["point"]):
+            t["point"] = [c * lf for c in t["point"]]
+        try:
+            out.append(Wall(**t))
+        except UserInputError as exc:
+            raise UserInputError(str(exc).replace("wall", where, 1)) from None
     return tuple(out)
 
 
@@ -267,6 +292,11 @@ def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
                 lines.append(_toml_protocol(v))
             else:
                 lines.append(f"{k} = {_toml_value(v)}")
+        lines.append("")
+    for table in d.get("wall", []):
+        lines.append("[[wall]]")
+        for k, v in table.items():
+            lines.append(f"{k} = [{', '.join(_toml_value(c) for c in v)}]")
         lines.append("")
     for table in d.get("flagellum", []):
         lines.append("[[flagellum]]")

@@ -405,6 +405,48 @@ def check_connector(config) -> None:
                 f"{-d:.3g} m; turn the motor axis along the surface normal or use lead = 'kink'")
 
 
+def check_walls(config) -> None:
+    """Refuse ``[[wall]]`` tables that cannot be run (one line naming the key, before any
+    work): more than one wall, a free-swimming body or the turning frame beside one (not built:
+    the swimmer's blobs move against the wall; the frame's symmetry is broken), a filament that
+    starts within its radius of the wall or behind it, a body across it."""
+    from flagwrap.errors import UserInputError
+    from flagwrap.geometry.helix import filament_positions
+
+    walls = config.walls
+    if len(walls) > 1:
+        raise UserInputError(f"{len(walls)} [[wall]] tables: one wall is supported (the "
+                             "Rotne-Prager-Blake mobility is a single plane's)")
+    w = walls[0]
+    if config.body.free:
+        raise UserInputError("[[wall]] with body.motion = 'free' is not built yet (the "
+                             "swimmer's blobs would move against the wall): hold the body "
+                             "(body.motion = 'fixed') or remove the wall")
+    if config.numerics.frame != "lab":
+        raise UserInputError(f"[[wall]] with numerics.frame = {config.numerics.frame!r}: a "
+                             "wall breaks the turning frame's symmetry; use numerics.frame = 'lab'")
+    fil = config.filament
+    L, a = fil.length, fil.cross_section_radius
+    n, p0 = w.unit_normal, np.asarray(w.point, float)
+    shape = filament_positions(fil, config.clamp) / L
+    for k, pl in enumerate(placements_from_config(config) or [Placement()]):
+        h = float(np.min((pl.apply(shape) * L - p0) @ n))
+        if h < a:
+            where = f"flagellum[{k}]" if config.flagella else "the filament"
+            raise UserInputError(
+                f"wall[0].point = {list(w.point)} m: {where} starts {h:.3g} m from the wall "
+                f"(on the side its normal points to), less than its radius a = {a:.3g} m: move "
+                "the wall or turn its normal")
+    if config.body.enabled:
+        from flagwrap.body.multiblob import cell_body_blobs
+
+        blobs, _ = cell_body_blobs(config)
+        h = float(np.min((blobs * L - p0) @ n))
+        if h < 0.0:
+            raise UserInputError(f"wall[0].point = {list(w.point)} m: the cell body crosses the "
+                                 f"wall ({-h:.3g} m behind it): move the wall or turn its normal")
+
+
 def _min_segment_distance(x, z) -> float:
     """The smallest distance between a segment of chain ``x`` and one of chain ``z``."""
     from flagwrap.interactions.self_contact import segment_closest

@@ -34,6 +34,7 @@ from flagwrap.body.cell_body import BodyContact, NoBody, ShapeContact, body_mobi
 from flagwrap.elasticity.rod import Frames
 from flagwrap.hydrodynamics.mobility import make_mobility
 from flagwrap.hydrodynamics.tube import TubeMobility
+from flagwrap.hydrodynamics.wall import WallMobility, config_wall
 from flagwrap.motor.drive import make_drive
 from flagwrap.motor.protocol import motor_schedule
 from flagwrap.system.layout import DofLayout
@@ -151,9 +152,16 @@ class RodSystem:
                       else MixedDrives(self.drives))
         self._assemble(config)
         num = config.numerics
-        self.mobility = mobility or body_mobility(config, self.radius) or make_mobility(
-            num.hydrodynamics, self.radius, backend=num.mobility_backend,
-            n=self.N, threads=num.threads, fmm_eps=num.mobility_tol)
+        #: the no-slip plane (``[[wall]]``) in core units, or None
+        self.wall = config_wall(config)
+        if mobility is None:
+            mobility = body_mobility(config, self.radius, self.wall)
+        if mobility is None:
+            mobility = make_mobility(num.hydrodynamics, self.radius, backend=num.mobility_backend,
+                                     n=self.N, threads=num.threads, fmm_eps=num.mobility_tol)
+            if self.wall is not None and num.hydrodynamics:
+                mobility = WallMobility(mobility, self.wall)
+        self.mobility = mobility
         if fil.hydrodynamic_model == "tube" and not isinstance(self.mobility, TubeMobility):
             # each filament's free beads, in the mobility's order (flagwrap.hydrodynamics.tube)
             ends = np.cumsum([0] + [p.nb for p in parts])
@@ -248,8 +256,19 @@ class RodSystem:
 
     def _config_interactions(self) -> list:
         c = self.config.contact
+        out = []
+        if self.wall is not None:
+            from flagwrap.interactions.wall import WallContact
+
+            active = np.ones(self.N, bool)
+            for p in self.parts:
+                active[p.bead0:p.bead0 + p.nc] = False
+            fil = self.config.filament
+            out.append(WallContact(self.wall, fil.cross_section_radius * (1.0 + c.range)
+                                   / fil.length, c.strength / self.bond, active,
+                                   c2=1.0 if c.potential == "wca-c2" else 0.0))
         if not c.self_contact:
-            return []
+            return out
         from flagwrap.interactions.self_contact import SelfContact, SelfContactInteraction
 
         sc = SelfContact(self.config.filament.cross_section_radius / self.config.filament.length,
@@ -257,7 +276,7 @@ class RodSystem:
                          strength=c.resolved_self_strength / self.bond,
                          c2=1.0 if c.potential == "wca-c2" else 0.0, rest_lengths=self.l0,
                          chains=None if len(self.parts) == 1 else [p.N for p in self.parts])
-        return [SelfContactInteraction(sc)]
+        return out + [SelfContactInteraction(sc)]
 
     # packing -------------------------------------------------------------------------------
     def initial_y(self) -> np.ndarray:

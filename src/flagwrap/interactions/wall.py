@@ -1,0 +1,62 @@
+"""Steric contact of the filament's beads with a plane wall (``[[wall]]``; docs/confinement.md).
+
+``U = sum_i u(d_i)``, ``d_i = (x_i - p) . n`` the height of bead ``i``'s centre above the plane
+through ``p`` with unit normal ``n`` (into the fluid), and ``u`` the cell body's contact law
+(:func:`flagwrap.body._kernels.wca_law`: WCA with cut-off ``a (1 + contact.range)``, energy
+``contact.strength``), so that the filament meets a wall as it meets the body. The gradient is
+``u'(d) n``; the Hessian ``u''(d) n n^T`` (a plane has no curvature). The joints' beads feel
+none (the motor holds them).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flagwrap.body import _kernels as BK
+
+
+class WallContact:
+    """The interaction (:mod:`flagwrap.interactions.base`) of beads ``active`` with the plane
+    ``wall`` (:class:`flagwrap.hydrodynamics.wall.PlaneWall`, core units)."""
+
+    name = "wall contact"
+    nonlocal_hessian = False
+    rotation_invariant = False
+
+    def __init__(self, wall, cutoff: float, strength: float, active, c2: float = 1.0):
+        self.wall = wall
+        self.cutoff = float(cutoff)
+        self.sigma = self.cutoff / 2.0 ** (1.0 / 6.0)
+        self.strength = float(strength)
+        self.c2 = float(c2)
+        self.active = np.asarray(active, bool)
+        self.distance = None  # the last evaluation's heights
+        self.energy = 0.0
+
+    def law(self, d):
+        d = np.ascontiguousarray(d, dtype=np.float64)
+        e, dU, d2U = np.empty(len(d)), np.empty(len(d)), np.empty(len(d))
+        BK.wca_law(d, self.sigma, self.strength, self.c2, e, dU, d2U)
+        return e, dU, d2U
+
+    def energy_grad(self, x, theta, grad_x, grad_theta) -> float:
+        d = self.wall.heights(x)
+        self.distance = d
+        on = self.active
+        e, dU, _ = self.law(d[on])
+        grad_x[on] += dU[:, None] * self.wall.normal
+        self.energy = float(e.sum())
+        return self.energy
+
+    def hessian_coo(self, x, theta):
+        d = self.wall.heights(x)
+        _, _, d2U = self.law(np.where(self.active, d, np.inf))
+        near = np.flatnonzero(d2U != 0.0)
+        if near.size == 0:
+            return None
+        n = self.wall.normal
+        H = d2U[near, None, None] * np.outer(n, n)[None]
+        base = 3 * near[:, None, None]
+        rows = np.broadcast_to(base + np.arange(3)[None, :, None], H.shape)
+        cols = np.broadcast_to(base + np.arange(3)[None, None, :], H.shape)
+        return rows.ravel(), cols.ravel(), H.ravel()

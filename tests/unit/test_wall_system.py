@@ -1,0 +1,200 @@
+"""A plane wall as a part of the system (``[[wall]]``; docs/confinement.md): every kind of
+system that takes one runs beside it, its mobility is the wall's, its steric contact holds the
+filament off it, the config round-trips, and every kind that does not take one is refused."""
+
+import math
+import tomllib
+
+import numpy as np
+import pytest
+
+from conftest import tiny_toml
+from flagwrap.errors import UserInputError
+from flagwrap.io.config import config_from_dict, config_to_toml
+
+SIDE = "[[wall]]\npoint = [0.08, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]\n"
+BODY = "[body]\nsurface = 'no-slip'\nblob_spacing = 0.025\n"
+
+
+def _cfg(numerics="", tables="", wall=SIDE, **kw):
+    text = tiny_toml(**kw).replace("[numerics]\n", "[numerics]\n" + numerics)
+    return config_from_dict(tomllib.loads(text + tables + wall))
+
+
+KINDS = {
+    "lab": ("", ""),
+    "krylov": ("linear_solver = 'krylov'\n", ""),
+    "no hydrodynamics (contact only)": ("hydrodynamics = false\n", ""),
+    "tube chain": ("", "", "hydrodynamic_model = 'tube'\n"),
+    "fixed no-slip body": ("", BODY),
+}
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_every_kind_of_system_runs_beside_a_wall(kind, tmp_path):
+    from flagwrap.hydrodynamics.tube import TubeMobility
+    from flagwrap.hydrodynamics.wall import WallMobility
+    from flagwrap.interactions.wall import WallContact
+    from flagwrap.io.runfile import config_of, read_run, write_run
+    from flagwrap.simulation import make_system, simulate
+
+    numerics, tables, *fil = KINDS[kind]
+    text = tiny_toml(ccw=0.2, cw=0.1).replace("[numerics]\n", "[numerics]\n" + numerics)
+    if fil:
+        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil[0])
+    cfg = config_from_dict(tomllib.loads(text + tables + SIDE))
+    s = make_system(cfg)
+    assert any(isinstance(it, WallContact) for it in s.interactions)
+    m = s.mobility.inner if isinstance(s.mobility, TubeMobility) else s.mobility
+    if not cfg.numerics.hydrodynamics:
+        assert type(m).__name__ == "LocalMobility"
+    elif cfg.body.no_slip:
+        assert m.wall is s.wall and isinstance(m._free, WallMobility)
+    else:
+        assert isinstance(m, WallMobility)
+    tr = simulate(cfg)
+    assert tr.ok and tr.n_steps > 0
+    write_run(tr, tmp_path / "run.nc")
+    assert config_of(read_run(tmp_path / "run.nc")).walls == cfg.walls  # stored
+
+
+def test_far_wall_is_free_space_and_near_wall_screens():
+    # the wall's correction decays as 1/h (Blake's image Stokeslet): 1000 L away the mobility
+    # is free space to ~1e-3 of its entries' scale; at 0.2 L it slows every bead
+    from flagwrap.simulation import make_system
+
+    free = make_system(_cfg(wall=""))
+    x = free.x0[free.free_beads]
+    M0 = free.mobility.matrix(x)
+    far = make_system(_cfg(wall="[[wall]]\npoint = [400.0, 0, 0]\nnormal = [-1.0, 0, 0]\n"))
+    Mf = far.mobility.matrix(x)
+    assert np.abs(Mf - M0).max() < 1e-3 * np.abs(M0).max()
+    near = make_system(_cfg())
+    Mn = near.mobility.matrix(x)
+    assert np.all(np.diag(Mn) < np.diag(M0))
+    assert np.linalg.eigvalsh(Mn).min() > 0 and np.abs(Mn - Mn.T).max() < 1e-14 * np.abs(Mn).max()
+
+
+def test_fixed_body_beside_a_wall_direct_and_krylov_agree(rng):
+    # the same mobility by the factorised blob matrix and by conjugate gradients on the
+    # matrix-free RPY + wall products (both to rounding of the CG's 1e-10 residual)
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
+    from flagwrap.body.multiblob import cell_body_blobs
+    from flagwrap.hydrodynamics.wall import config_wall
+
+    cfg = _cfg(tables=BODY.replace("0.025", "0.04"))
+    blobs, radii = cell_body_blobs(cfg)
+    wall = config_wall(cfg)
+    d = FixedBodyMobility(0.004, blobs, radii, "direct", wall=wall)
+    k = FixedBodyMobility(0.004, blobs, radii, "krylov", wall=wall)
+    x = np.array([[0.05, 0.0, -0.05], [0.1, 0.02, -0.1], [0.15, -0.03, -0.2]])
+    F = rng.normal(size=(3, 3))
+    M = d.matrix(x)
+    np.testing.assert_allclose(d.apply(x, F).ravel(), M @ F.ravel(), rtol=0, atol=1e-12 * np.abs(M).max())
+    np.testing.assert_allclose(k.apply(x, F).ravel(), M @ F.ravel(), rtol=0, atol=1e-8 * np.abs(M).max())
+    assert np.linalg.eigvalsh(M).min() > 0
+
+
+def test_wall_contact_force_is_its_energy_gradient(rng):
+    from flagwrap.hydrodynamics.wall import PlaneWall
+    from flagwrap.interactions.wall import WallContact
+
+    wall = PlaneWall([0.1, -0.2, 0.3], [1.0, 2.0, -0.5])
+    c = WallContact(wall, cutoff=0.02, strength=3.0, active=np.ones(6, bool))
+    x = wall.point + np.outer(rng.uniform(0.004, 0.03, 6), wall.normal) + 0.01 * rng.normal(size=(6, 3)) * [1, 1, 1]
+    x = x - np.outer(wall.heights(x) - rng.uniform(0.004, 0.03, 6), wall.normal)
+    g = np.zeros((6, 3))
+    c.energy_grad(x, None, g, None)
+    h = 1e-7
+    for i in range(6):
+        for k in range(3):
+            xp, xm = x.copy(), x.copy()
+            xp[i, k] += h
+            xm[i, k] -= h
+            ep = c.energy_grad(xp, None, np.zeros((6, 3)), None)
+            em = c.energy_grad(xm, None, np.zeros((6, 3)), None)
+            assert g[i, k] == pytest.approx((ep - em) / (2 * h), rel=1e-5, abs=1e-6 * np.abs(g).max())
+    r, cc, v = c.hessian_coo(x, None)
+    H = np.zeros((18, 18))
+    np.add.at(H, (r, cc), v)
+    for i in range(6):  # a column of the Hessian by differences of the gradient
+        gp, gm = np.zeros((6, 3)), np.zeros((6, 3))
+        xp, xm = x.copy(), x.copy()
+        xp[i, 2] += h
+        xm[i, 2] -= h
+        c.energy_grad(xp, None, gp, None)
+        c.energy_grad(xm, None, gm, None)
+        np.testing.assert_allclose(H[:, 3 * i + 2], ((gp - gm) / (2 * h)).ravel(), rtol=1e-4,
+                                   atol=1e-6 * np.abs(H).max())
+
+
+def test_contact_holds_the_filament_off_a_wall_it_is_pushed_against():
+    # a wall 1.5 a under the free end of a heavy filament (gravity along -z, the run's own
+    # settling): contact keeps every bead's centre above the wall (the cut-off is 2 a)
+    from flagwrap.simulation import simulate
+
+    fil = "density_mismatch = 50.0\n"
+    text = tiny_toml(ccw=0.5, cw=0.0, machin=100).replace(
+        ', {direction = "cw", turns = 0.0}', "").replace("n_beads = 21\n", "n_beads = 21\n" + fil)
+    base = config_from_dict(tomllib.loads(text))
+    from flagwrap.geometry.helix import filament_positions
+
+    a = base.filament.cross_section_radius
+    z0 = float(filament_positions(base.filament, base.clamp)[:, 2].min())
+    wall = f"[[wall]]\npoint = [0.0, 0.0, {z0 - 1.5 * a!r}]\nnormal = [0.0, 0.0, 1.0]\n"
+    cfg = config_from_dict(tomllib.loads(text + wall))
+    tr = simulate(cfg)
+    assert tr.ok
+    z = np.asarray(tr.x)[..., 2] * cfg.filament.length
+    free = simulate(base)
+    zf = np.asarray(free.x)[..., 2] * cfg.filament.length
+    assert zf.min() < z0 - 2 * a  # without the wall it sinks through where the wall is
+    assert z.min() > z0 - 1.5 * a + 0.5 * a  # with it, no centre within a / 2 of the wall
+
+
+def test_config_round_trips_the_wall():
+    cfg = _cfg()
+    again = config_from_dict(tomllib.loads(config_to_toml(cfg)))
+    assert again.walls == cfg.walls and again.walls[0].normal == (-1.0, 0.0, 0.0)
+    assert config_from_dict(tomllib.loads(tiny_toml())).walls == ()
+
+
+REFUSED = {
+    "zero normal": ("[[wall]]\npoint = [0.08, 0, 0]\nnormal = [0.0, 0.0, 0.0]\n", "", "",
+                    "wall[0].normal must not be zero"),
+    "filament across": ("[[wall]]\npoint = [0.02, 0, 0]\nnormal = [-1.0, 0, 0]\n", "", "",
+                        "wall[0].point"),
+    "body across": ("[[wall]]\npoint = [0.0, 0, 0.05]\nnormal = [0.0, 0, -1.0]\n", "", "",
+                    "cell body crosses the wall"),
+    "two walls": (SIDE + SIDE.replace("0.08", "0.09"), "", "", "one wall is supported"),
+    "free body": (SIDE, "", BODY + "motion = 'free'\n", "body.motion = 'free'"),
+    "turning frame": (SIDE, "frame = 'rotating'\n", "", "numerics.frame = 'rotating'"),
+    "unknown key": ("[[wall]]\npoint = [0.08, 0, 0]\nnormal = [-1, 0, 0]\nradius = 1\n", "", "",
+                    "unknown key wall[0].radius"),
+}
+
+
+@pytest.mark.parametrize("case", list(REFUSED))
+def test_bad_walls_are_refused_by_the_cli(case, tmp_path, capsys):
+    # one line naming the key, exit 2, nothing written
+    from flagwrap.cli.main import main
+
+    wall, numerics, tables, words = REFUSED[case]
+    path = tmp_path / "bad.toml"
+    path.write_text(tiny_toml().replace("[numerics]\n", "[numerics]\n" + numerics) + tables + wall)
+    out = tmp_path / "bad.nc"
+    assert main(["run", str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and words in err[0] and not out.exists()
+    with pytest.raises(UserInputError):
+        config_from_dict(tomllib.loads(path.read_text()))
+
+
+def test_wall_normal_need_not_be_unit():
+    cfg = _cfg(wall="[[wall]]\npoint = [0.08, 0, 0]\nnormal = [-3.0, 0, 0]\n")
+    from flagwrap.hydrodynamics.wall import config_wall
+
+    w = config_wall(cfg)
+    np.testing.assert_allclose(w.normal, [-1.0, 0.0, 0.0])
+    assert w.point[0] == pytest.approx(0.08 / cfg.filament.length)
+    assert math.isclose(float(w.heights(w.point + w.normal)), 1.0)
