@@ -21,8 +21,10 @@ def _cfg(numerics="", tables="", wall=SIDE, **kw):
     return config_from_dict(tomllib.loads(text + tables + wall))
 
 
+FLOOR = "[[wall]]\npoint = [0.0, 0.0, -0.17]\nnormal = [0.0, 0.0, 1.0]\n"
 KINDS = {
     "lab": ("", ""),
+    "turning frame, floor wall": ("frame = 'rotating'\n", "", None, FLOOR),
     "krylov": ("linear_solver = 'krylov'\n", ""),
     "no hydrodynamics (contact only)": ("hydrodynamics = false\n", ""),
     "tube chain": ("", "", "hydrodynamic_model = 'tube'\n"),
@@ -38,11 +40,13 @@ def test_every_kind_of_system_runs_beside_a_wall(kind, tmp_path):
     from flagwrap.io.runfile import config_of, read_run, write_run
     from flagwrap.simulation import make_system, simulate
 
-    numerics, tables, *fil = KINDS[kind]
+    numerics, tables, *more = KINDS[kind]
+    fil = more[0] if more else None
+    wall = more[1] if len(more) > 1 else SIDE
     text = tiny_toml(ccw=0.2, cw=0.1).replace("[numerics]\n", "[numerics]\n" + numerics)
     if fil:
-        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil[0])
-    cfg = config_from_dict(tomllib.loads(text + tables + SIDE))
+        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil)
+    cfg = config_from_dict(tomllib.loads(text + tables + wall))
     s = make_system(cfg)
     assert any(isinstance(it, WallContact) for it in s.interactions)
     m = s.mobility.inner if isinstance(s.mobility, TubeMobility) else s.mobility
@@ -56,6 +60,25 @@ def test_every_kind_of_system_runs_beside_a_wall(kind, tmp_path):
     assert tr.ok and tr.n_steps > 0
     write_run(tr, tmp_path / "run.nc")
     assert config_of(read_run(tmp_path / "run.nc")).walls == cfg.walls  # stored
+
+
+def test_floor_wall_turning_frame_agrees_with_the_lab_and_raises_the_threshold():
+    # a wall square to the motor axis keeps the turning frame's symmetry: the steady whirl of
+    # both frames agrees (as without a wall, to the tolerance's error), and the linear
+    # threshold rises as the wall slows the distal turns (docs/confinement.md)
+    from flagwrap.simulation import simulate
+    from flagwrap.stability.threshold import critical_from_config
+
+    text = tiny_toml(ccw=2.0, cw=0.05, machin=100).replace("tol = 1e-3", "tol = 1e-6")
+    tips = []
+    for frame in ("lab", "rotating"):
+        tr = simulate(config_from_dict(tomllib.loads(
+            text.replace("[numerics]\n", f"[numerics]\nframe = '{frame}'\n") + FLOOR)))
+        tips.append(np.asarray(tr.x)[-1][-1])
+    assert np.linalg.norm(tips[0] - tips[1]) < 2e-5  # L; 5.2e-6 measured (4.6e-6 without a wall)
+    free = critical_from_config(config_from_dict(tomllib.loads(tiny_toml())), "cw")
+    near = critical_from_config(config_from_dict(tomllib.loads(tiny_toml() + FLOOR)), "cw")
+    assert near.machin_c > free.machin_c * 1.03  # 1411 against 1324 measured
 
 
 def test_far_wall_is_free_space_and_near_wall_screens():
@@ -168,7 +191,7 @@ REFUSED = {
                     "cell body crosses the wall"),
     "two walls": (SIDE + SIDE.replace("0.08", "0.09"), "", "", "one wall is supported"),
     "free body": (SIDE, "", BODY + "motion = 'free'\n", "body.motion = 'free'"),
-    "turning frame": (SIDE, "frame = 'rotating'\n", "", "numerics.frame = 'rotating'"),
+    "turning frame, side wall": (SIDE, "frame = 'rotating'\n", "", "numerics.frame = 'rotating'"),
     "unknown key": ("[[wall]]\npoint = [0.08, 0, 0]\nnormal = [-1, 0, 0]\nradius = 1\n", "", "",
                     "unknown key wall[0].radius"),
 }

@@ -55,6 +55,12 @@ class PlaneWall:
         self.normal = n
         self.frame = np.ascontiguousarray(np.array([t1, np.cross(n, t1), n]))
 
+    @property
+    def square_to_z(self) -> bool:
+        """The plane is ``z = const`` (normal along the body axis): it is symmetric about every
+        axis along z, so a motor on the body axis sees it the same at every angle."""
+        return bool(math.hypot(self.normal[0], self.normal[1]) < 1e-12)
+
     def heights(self, x) -> np.ndarray:
         """Signed distances of the points ``x`` (..., 3) from the plane (positive in the fluid)."""
         return (np.asarray(x, float) - self.point) @ self.normal
@@ -187,16 +193,16 @@ def wall_correction_apply(wall: PlaneWall, xt, at, xs, as_, Fs) -> np.ndarray:
 
 class WallMobility:
     """A bead mobility beside a plane wall: ``base`` (free-space RPY, any backend) plus the
-    wall's ``Delta`` (module docstring). Beads of one radius ``base.radius``. Not symmetric
-    about the motor axis unless the wall is square to it, which the turning frame does not
-    use (``axisymmetric = False``)."""
+    wall's ``Delta`` (module docstring). Beads of one radius ``base.radius``. Symmetric about
+    the motor (body) axis, as the turning frame needs, when the wall is square to it
+    (``axisymmetric``): its Delta is then covariant under rotations about z."""
 
     long_range = True
-    axisymmetric = False
 
     def __init__(self, base, wall: PlaneWall):
         self.base = base
         self.wall = wall
+        self.axisymmetric = wall.square_to_z and getattr(base, "axisymmetric", True)
         self.radius = base.radius
         self.self_mobility = base.self_mobility
         self.backend = f"{getattr(base, 'backend', 'direct')}+wall"

@@ -21,10 +21,11 @@ class WallContact:
 
     name = "wall contact"
     nonlocal_hessian = False
-    rotation_invariant = False
 
     def __init__(self, wall, cutoff: float, strength: float, active, c2: float = 1.0):
         self.wall = wall
+        #: a plane square to the body axis is unchanged by turning about it
+        self.rotation_invariant = wall.square_to_z
         self.cutoff = float(cutoff)
         self.sigma = self.cutoff / 2.0 ** (1.0 / 6.0)
         self.strength = float(strength)

@@ -407,9 +407,10 @@ def check_connector(config) -> None:
 
 def check_walls(config) -> None:
     """Refuse ``[[wall]]`` tables that cannot be run (one line naming the key, before any
-    work): more than one wall, a free-swimming body or the turning frame beside one (not built:
-    the swimmer's blobs move against the wall; the frame's symmetry is broken), a filament that
-    starts within its radius of the wall or behind it, a body across it."""
+    work): more than one wall, a free-swimming body beside one (not built: the swimmer's blobs
+    move against the wall), the turning frame beside a wall not square to the body axis (its
+    symmetry is broken), a filament that starts within its radius of the wall or behind it, a
+    body across it."""
     from flagwrap.errors import UserInputError
     from flagwrap.geometry.helix import filament_positions
 
@@ -422,9 +423,10 @@ def check_walls(config) -> None:
         raise UserInputError("[[wall]] with body.motion = 'free' is not built yet (the "
                              "swimmer's blobs would move against the wall): hold the body "
                              "(body.motion = 'fixed') or remove the wall")
-    if config.numerics.frame != "lab":
+    if config.numerics.frame != "lab" and math.hypot(*w.normal[:2]) > 1e-12 * math.hypot(*w.normal):
         raise UserInputError(f"[[wall]] with numerics.frame = {config.numerics.frame!r}: a "
-                             "wall breaks the turning frame's symmetry; use numerics.frame = 'lab'")
+                             "wall tilted from the plane z = const breaks the turning frame's "
+                             "symmetry; use numerics.frame = 'lab' (or wall.normal = [0, 0, +-1])")
     fil = config.filament
     L, a = fil.length, fil.cross_section_radius
     n, p0 = w.unit_normal, np.asarray(w.point, float)
