@@ -31,7 +31,7 @@ import math
 import numba as nb
 import numpy as np
 
-from flagwrap.hydrodynamics._wall_kernel import wall_block
+from flagwrap.hydrodynamics._wall_kernel import wall_block, wall_coefficients
 from flagwrap.hydrodynamics.polydisperse import _pair
 
 _C8 = 1.0 / (8.0 * math.pi)
@@ -74,6 +74,32 @@ class PlaneWall:
 
 
 @nb.njit(cache=True, inline="always")
+def _rpy_difference(xi, yi, zi, ai, xj, yj, zj, aj, out):
+    """``out`` += ``b_i b_j RPY(x~) - RPY(x)`` (wall frame): the free part's change where a
+    sphere reaches below its radius (zero otherwise)."""
+    zti = max(zi, ai)
+    ztj = max(zj, aj)
+    bij = min(1.0, zi / ai) * min(1.0, zj / aj)
+    for s in range(2):
+        d0 = xi - xj
+        d1 = yi - yj
+        d2 = (zti - ztj) if s == 0 else (zi - zj)
+        r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        f, g = _pair(r, ai, aj)
+        g = g / (r * r) if r > 0.0 else 0.0
+        c = bij if s == 0 else -1.0
+        out[0, 0] += c * (f + g * d0 * d0)
+        out[0, 1] += c * g * d0 * d1
+        out[0, 2] += c * g * d0 * d2
+        out[1, 0] += c * g * d1 * d0
+        out[1, 1] += c * (f + g * d1 * d1)
+        out[1, 2] += c * g * d1 * d2
+        out[2, 0] += c * g * d2 * d0
+        out[2, 1] += c * g * d2 * d1
+        out[2, 2] += c * (f + g * d2 * d2)
+
+
+@nb.njit(cache=True, inline="always")
 def _delta_block(xi, yi, zi, ai, xj, yj, zj, aj, out):
     """``out`` (3, 3), wall frame: ``Delta_ij`` of the module docstring for the target at
     ``(xi, yi, zi)`` of radius ``ai`` and the source at ``(xj, ...)`` of radius ``aj``."""
@@ -83,28 +109,8 @@ def _delta_block(xi, yi, zi, ai, xj, yj, zj, aj, out):
     w = wall_block(xi - xj, yi - yj, zti + ztj, ztj, ai, aj)
     for k in range(9):
         out[k // 3, k % 3] = bij * _C8 * w[k]
-    near = zi < ai or zj < aj
-    if near:  # the free part moves too: b_i b_j RPY(x~) - RPY(x)
-        for s in range(2):
-            d0 = xi - xj
-            d1 = yi - yj
-            d2 = (zti - ztj) if s == 0 else (zi - zj)
-            r = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            f, g = _pair(r, ai, aj)
-            if r > 0.0:
-                g = g / (r * r)
-            else:
-                g = 0.0
-            c = bij if s == 0 else -1.0
-            out[0, 0] += c * (f + g * d0 * d0)
-            out[0, 1] += c * g * d0 * d1
-            out[0, 2] += c * g * d0 * d2
-            out[1, 0] += c * g * d1 * d0
-            out[1, 1] += c * (f + g * d1 * d1)
-            out[1, 2] += c * g * d1 * d2
-            out[2, 0] += c * g * d2 * d0
-            out[2, 1] += c * g * d2 * d1
-            out[2, 2] += c * (f + g * d2 * d2)
+    if zi < ai or zj < aj:
+        _rpy_difference(xi, yi, zi, ai, xj, yj, zj, aj, out)
 
 
 @nb.njit(cache=True)
@@ -137,19 +143,56 @@ def wall_cross_matrix(xt, at, xs, as_, Q, out):
 @nb.njit(cache=True)
 def wall_cross_apply(xt, at, xs, as_, Fs, ut):
     """``ut`` (n, 3) += ``Delta Fs`` with everything in the wall frame (O(n m) time, no
-    matrix)."""
-    B = np.empty((3, 3))
-    for i in range(xt.shape[0]):
+    matrix). The image part straight from the coefficients (``8 pi W F = A F + B e (e.F) +
+    C e F_z + D n (e.F) + E n F_z``), the regularised RPY difference only for pairs with a
+    sphere below its radius."""
+    n, m = xt.shape[0], xs.shape[0]
+    zs = np.empty(m)  # the sources' raised heights and damping
+    bs = np.empty(m)
+    near_s = np.zeros(m, np.bool_)
+    for j in range(m):
+        zs[j] = max(xs[j, 2], as_[j])
+        bs[j] = min(1.0, xs[j, 2] / as_[j])
+        near_s[j] = xs[j, 2] < as_[j]
+    any_near_s = near_s.any()
+    for i in range(n):
+        ai = at[i]
+        zi = max(xt[i, 2], ai)
+        bi = min(1.0, xt[i, 2] / ai)
+        near_i = xt[i, 2] < ai
         u0 = 0.0
         u1 = 0.0
         u2 = 0.0
-        for j in range(xs.shape[0]):
-            _delta_block(xt[i, 0], xt[i, 1], xt[i, 2], at[i], xs[j, 0], xs[j, 1], xs[j, 2],
-                         as_[j], B)
-            f0, f1, f2 = Fs[j, 0], Fs[j, 1], Fs[j, 2]
-            u0 += B[0, 0] * f0 + B[0, 1] * f1 + B[0, 2] * f2
-            u1 += B[1, 0] * f0 + B[1, 1] * f1 + B[1, 2] * f2
-            u2 += B[2, 0] * f0 + B[2, 1] * f1 + B[2, 2] * f2
+        for j in range(m):
+            r1 = xt[i, 0] - xs[j, 0]
+            r2 = xt[i, 1] - xs[j, 1]
+            r3 = zi + zs[j]
+            rho = math.sqrt(r1 * r1 + r2 * r2 + r3 * r3)
+            ir = 1.0 / rho
+            e0, e1, e2 = r1 * ir, r2 * ir, r3 * ir
+            A, B, C, D, E = wall_coefficients(rho, e2, zs[j], ai, as_[j])
+            c = bi * bs[j] * _C8
+            f0, f1, f2 = c * Fs[j, 0], c * Fs[j, 1], c * Fs[j, 2]
+            eF = e0 * f0 + e1 * f1 + e2 * f2
+            s = B * eF + C * f2
+            u0 += A * f0 + s * e0
+            u1 += A * f1 + s * e1
+            u2 += A * f2 + s * e2 + D * eF + E * f2
+        if near_i or any_near_s:
+            B3 = np.empty((3, 3))
+            for j in range(m):
+                if near_i or near_s[j]:
+                    B3[:, :] = 0.0
+                    _rpy_difference(xt[i, 0], xt[i, 1], xt[i, 2], ai, xs[j, 0], xs[j, 1],
+                                    xs[j, 2], as_[j], B3)
+                    for p in range(3):
+                        v = B3[p, 0] * Fs[j, 0] + B3[p, 1] * Fs[j, 1] + B3[p, 2] * Fs[j, 2]
+                        if p == 0:
+                            u0 += v
+                        elif p == 1:
+                            u1 += v
+                        else:
+                            u2 += v
         ut[i, 0] += u0
         ut[i, 1] += u1
         ut[i, 2] += u2
