@@ -221,3 +221,26 @@ def test_wall_normal_need_not_be_unit():
     np.testing.assert_allclose(w.normal, [-1.0, 0.0, 0.0])
     assert w.point[0] == pytest.approx(0.08 / cfg.filament.length)
     assert math.isclose(float(w.heights(w.point + w.normal)), 1.0)
+
+
+def test_analyze_reports_the_gap_to_the_wall(tmp_path, capsys):
+    # the run file's positions against the stored wall: the smallest gap is the beads'
+    # heights less a, computed here from the positions directly
+    from flagwrap.cli.main import main
+    from flagwrap.io.runfile import read_run
+
+    path = tmp_path / "w.toml"
+    path.write_text(tiny_toml(ccw=0.2, cw=0.1) + SIDE)
+    out = tmp_path / "w.nc"
+    assert main(["run", str(path), "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["analyze", str(out), "--json", "--no-write"]) == 0
+    import json
+
+    res = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    x = read_run(out)["position"].values
+    gap = (0.08 - x[..., 0]) - 0.0015
+    assert res["wall"]["gap_min"] == pytest.approx(gap.min(), rel=1e-12)
+    assert res["wall"]["gap_final"] == pytest.approx(gap[-1].min(), rel=1e-12)
+    assert main(["analyze", str(out), "--no-write"]) == 0
+    assert "wall: closest bead surface" in capsys.readouterr().out

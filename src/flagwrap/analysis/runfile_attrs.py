@@ -196,6 +196,10 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
     from flagwrap.observables.swimming import swimming_summary
 
     res["swimming"] = swimming_summary(ds, final_turns=a.final.final_turns)
+    from flagwrap.observables.wall import wall_summary
+
+    wall = wall_summary(ds)
+    res["wall"] = None if wall is None else {k: v for k, v in wall.items() if k != "gap_series"}
     res["params"] = a.params()
     res["path"] = str(path)
     res["run_status"] = str(ds.attrs.get("status", ""))

@@ -121,6 +121,11 @@ def run(args) -> int:
                   f"free end is {rise:+.3f} L from its CCW baseline, under the {args.threshold:g} L "
                   "threshold (a transient, or a decaying wobble on a soft hook); 'buckled' is the "
                   "paper's rule (docs/analysis.md)")
+        if res.get("wall"):
+            w = res["wall"]
+            print(f"  wall: closest bead surface {w['gap_min']:+.3g} m from it (at turn "
+                  f"{w['gap_min_turns']:.2f}), {w['gap_final']:+.3g} m at the end; free end "
+                  f"{w['tip_height_final']:.3g} m above it")
         for ph in res["swimming"]:  # a free swimmer, phase by phase (second half of each)
             what = "last turns" if ph["direction"] == "final" else f"{ph['direction']} phase"
             print(f"  swimming, {what} ({ph['t0']:.3g}-{ph['t1']:.3g} s): "
