@@ -87,3 +87,19 @@ def test_a_torque_speed_motor_is_judged_against_the_whirls_torque(tiny, capsys):
             continue
         assert main(["stability", str(tiny / "ts.toml")]) == 0
         assert word in capsys.readouterr().out
+
+
+def test_progress_from_the_first_second_off_a_terminal(tiny, capsys):
+    # issue 34, item 1: a batch job (stderr not a TTY) sees what the command is doing before
+    # the first state is found, then one line per steady state; --no-progress and --json none
+    from flagwrap.cli.main import main
+
+    code = main(["stability", str(tiny / "tiny.toml"), "--m-max", "40"])
+    err = capsys.readouterr().err.splitlines()
+    assert code == 1
+    assert err[0].startswith("flagwrap stability") and "from M = 10 up to 40" in err[0]
+    states = [line for line in err if line.lstrip().startswith("M = ")]
+    assert len(states) >= 3 and "leading eigenvalue" in states[0]
+    for quiet in (["--no-progress"], ["--json"]):
+        main(["stability", str(tiny / "tiny.toml"), "--m-max", "40", *quiet])
+        assert capsys.readouterr().err == ""

@@ -100,13 +100,27 @@ def run(args) -> int:
     if args.no_hi:
         cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
     m_max = resolve_m_max(cfg, args.m_start, args.m_max)
-    bar = _bar(not (args.json or args.no_progress) and sys.stderr.isatty(), args.m_start, m_max)
+    progress = not (args.json or args.no_progress)
+    bar = _bar(progress and sys.stderr.isatty(), args.m_start, m_max)
+    if progress:  # what it is doing, from the first second (a log line per state off a TTY)
+        import time
+
+        t0 = time.perf_counter()
+        fil = cfg.filament
+        body = (f", a {cfg.body.motion} no-slip body" if cfg.body.no_slip else "")
+        print(f"flagwrap stability {cfg.name}: {fil.n_beads} beads{body}; following the steady "
+              f"{args.direction.upper()} whirl from M = {args.m_start:g} up to {m_max:.4g} "
+              "(each state: Newton, then the leading eigenvalues)", file=sys.stderr, flush=True)
 
     def show(p):
         if bar is not None:
             bar.postfix[0] = p.machin
             bar.n = round(min(bar.total, max(0.0, math.log(p.machin / args.m_start))), 3)
             bar.refresh()
+        elif progress:
+            lam = p.leading
+            print(f"  M = {p.machin:.5g}: leading eigenvalue {lam.real:+.3e} {abs(lam.imag):+.3g}i "
+                  f"omega ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
 
     try:
         res = critical_from_config(cfg, args.direction, m_start=args.m_start, m_max=m_max,
