@@ -407,3 +407,30 @@ def test_the_estimate_prices_a_no_slip_body_and_names_its_spacing():
         check_memory(fine, limit=0.5 * estimate(fine).blob_memory)
     krylov = fine.replace(body=dataclasses.replace(fine.body, solver="krylov"))
     assert estimate(krylov).blob_memory < 0.01 * estimate(fine).blob_memory
+
+
+def test_sigterm_stops_a_critical_search_without_a_traceback(tmp_path):
+    # `flagwrap critical` under `timeout` or a scheduler's limit: one line naming the signal
+    # and the cache it resumes from, exit 143 (it used to end in a RunInterrupted traceback)
+    import signal
+    import time
+
+    cfgp = tmp_path / "long.toml"
+    cfgp.write_text(tiny_toml().replace("tol = 1e-3", "tol = 1e-7"))
+    cache = tmp_path / "cache"
+    proc = subprocess.Popen([sys.executable, "-m", "flagwrap.cli.main", "critical", str(cfgp),
+                             "--cache", str(cache)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL))
+    t0 = time.monotonic()  # the header is printed once the search starts
+    line = proc.stdout.readline()
+    assert "critical search" in line, line
+    time.sleep(3)
+    assert proc.poll() is None  # still searching (tol 1e-7: minutes of work)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=300)
+    assert proc.returncode == 143, err
+    assert "Traceback" not in err
+    assert re.search(r"interrupted \(SIGTERM\) during a run at t/T=[0-9.]+; the runs finished "
+                     rf"before it are cached in {re.escape(str(cache))}", err), err
+    assert time.monotonic() - t0 < 300

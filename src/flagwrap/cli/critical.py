@@ -50,6 +50,7 @@ def _fmt(v, f):
 
 def run(args) -> int:
     import json
+    import sys
 
     from flagwrap.analysis.critical import CriticalSearch, RunCache
     from flagwrap.io.config import load_config_or_case
@@ -76,7 +77,15 @@ def run(args) -> int:
               f"{args.cw_turns:g} CW turns, HI {'on' if cfg.numerics.hydrodynamics else 'off'}); "
               f"scaling-line M_c = {cfg.machin_critical_scaling:.1f}; gravity number G = "
               f"{cfg.gravity_number:.4g}", flush=True)
-    search.compute(cfg, guess=args.guess, bracket=args.bracket)
+    from flagwrap.simulation import RunInterrupted
+
+    try:
+        search.compute(cfg, guess=args.guess, bracket=args.bracket)
+    except RunInterrupted as stop:  # Ctrl-C or SIGTERM (a scheduler's limit): no traceback
+        print(f"flagwrap critical: interrupted ({stop.signame or 'SIGINT'}) during a run at "
+              f"{stop.trajectory.message.split(':')[0]}; the runs finished before it are cached "
+              f"in {args.cache}: the same command resumes from them", file=sys.stderr)
+        return 143 if stop.signame == "SIGTERM" else 130
     s = search.summary()
     if args.json:
         from flagwrap.sweep.store import jsonable  # NaN -> null at every depth (runs too)
