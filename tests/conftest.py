@@ -44,6 +44,25 @@ tol = 1e-3
 """
 
 
+NO_SLIP_BODY = "[body]\nsurface = 'no-slip'\nblob_spacing = 0.025\n"
+
+
+def system_kinds(polar_deg=30) -> dict:
+    """``{name: (numerics lines, tables)}``: every kind of system a feature must run on, as
+    TOML added to :func:`tiny_toml`'s ``[numerics]`` and appended to it (the two flagella sit
+    ``polar_deg`` from the pole, on opposite sides)."""
+    free = NO_SLIP_BODY + "motion = 'free'\n"
+    return {
+        "lab": ("", ""),
+        "turning frame": ("frame = 'rotating'\n", ""),
+        "krylov": ("linear_solver = 'krylov'\n", ""),
+        "fixed no-slip body": ("", NO_SLIP_BODY),
+        "free cell": ("", free),
+        "two flagella on a free cell": ("", free + "".join(
+            f"[[flagellum]]\npolar_deg = {polar_deg}\nazimuth_deg = {az}\n" for az in (0, 180))),
+    }
+
+
 @pytest.fixture(scope="session")
 def tiny_run(tmp_path_factory):
     """Run file of :func:`tiny_toml` (read-only for the tests that share it)."""

@@ -9,7 +9,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from conftest import tiny_toml
+from conftest import system_kinds, tiny_toml
 from flagwrap.errors import UserInputError
 from flagwrap.geometry.helix import connector_arm_bonds, filament_positions, held_beads
 from flagwrap.io.config import config_from_dict
@@ -74,19 +74,10 @@ def test_start_is_stress_free_and_the_arm_is_held(joint):
     assert s.rest.cbend[nh - 1] == kink.rest.cbend[1]
 
 
-BODY = "[body]\nsurface = 'no-slip'\nblob_spacing = 0.025\n"
-KINDS = {
-    "lab": ("", ""),
-    "turning frame": ("frame = 'rotating'\n", ""),
-    "krylov": ("linear_solver = 'krylov'\n", ""),
-    "no body": ("", "[body]\nenabled = false\n"),
-    "fixed no-slip body": ("", BODY),
-    "free cell": ("", BODY + "motion = 'free'\n"),
-    "two flagella on a free cell": ("", BODY + "motion = 'free'\n" + "".join(
-        f"[[flagellum]]\npolar_deg = 45\nazimuth_deg = {az}\n" for az in (0, 180))),
-    "torque motor": ("", "", "[motor]\nkind = 'torque-speed'\nstall_torque = 2e-4\n"
-                             "zero_load_speed = 0.05\n"),
-}
+KINDS = {**system_kinds(polar_deg=45),  # at 30 deg the two arms would cross
+         "no body": ("", "[body]\nenabled = false\n"),
+         "torque motor": ("", "", "[motor]\nkind = 'torque-speed'\nstall_torque = 2e-4\n"
+                                  "zero_load_speed = 0.05\n")}
 
 
 @pytest.mark.parametrize("kind", list(KINDS))

@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from conftest import system_kinds
 from flagwrap.body.multiblob import resistance_matrix
 from flagwrap.errors import UserInputError
 from flagwrap.hydrodynamics.mobility import RPYMobility
@@ -217,16 +218,7 @@ def _tiny(extra_numerics="", tables=""):
     return config_from_dict(tomllib.loads(text + tables))
 
 
-BODY = "[body]\nsurface = 'no-slip'\nblob_spacing = 0.025\n"
-KINDS = {
-    "lab": ("", ""),
-    "turning frame": ("frame = 'rotating'\n", ""),
-    "krylov": ("linear_solver = 'krylov'\n", ""),
-    "fixed no-slip body": ("", BODY),
-    "free cell": ("", BODY + "motion = 'free'\n"),
-    "two flagella on a free cell": ("", BODY + "motion = 'free'\n" + "".join(
-        f"[[flagellum]]\npolar_deg = 30\nazimuth_deg = {az}\n" for az in (0, 180))),
-}
+KINDS = system_kinds()
 
 
 @pytest.mark.parametrize("kind", list(KINDS))
