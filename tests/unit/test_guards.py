@@ -12,6 +12,7 @@ import os
 import re
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import h5py
@@ -434,3 +435,50 @@ def test_sigterm_stops_a_critical_search_without_a_traceback(tmp_path):
     assert re.search(r"interrupted \(SIGTERM\) during a run at t/T=[0-9.]+; the runs finished "
                      rf"before it are cached in {re.escape(str(cache))}", err), err
     assert time.monotonic() - t0 < 300
+
+
+def test_a_file_size_limit_ends_in_a_message_not_a_crash(tmp_path):
+    # issue 33, item 1: HDF5 writing into a full disk / past `ulimit -f` used to kill the
+    # process by a signal (exit -11, nothing said); the file is now built in memory and its
+    # bytes written plainly, so the failure is an OSError reported in one line, exit 1, and
+    # no empty rescue file is left behind
+    import resource
+
+    cfgp = tmp_path / "t.toml"
+    cfgp.write_text(tiny_toml(ccw=1, cw=1))
+    limit = 50 * 1024  # bytes: the run file is ~100 kB
+
+    def cap():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    before = set(Path(tempfile.gettempdir()).glob("flagwrap-rescued-t-*"))
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "run", str(cfgp), "--quiet",
+                        "-o", str(tmp_path / "t.nc"), "--checkpoint", str(tmp_path / "t.ckpt.h5"),
+                        "--checkpoint-every", "20"], capture_output=True, text=True,
+                       timeout=300, preexec_fn=cap)
+    assert r.returncode == 1, r.stderr
+    assert "Traceback" not in r.stderr
+    assert re.search(r"error: could not write the run file to \S+t\.nc \(File too large\)",
+                     r.stderr), r.stderr
+    assert not (tmp_path / "t.nc").exists() and not list(tmp_path.glob("*.lock"))
+    assert set(Path(tempfile.gettempdir()).glob("flagwrap-rescued-t-*")) == before
+
+
+def test_analyze_names_a_partial_run_that_stopped_before_the_reversal(tmp_path, capsys):
+    from flagwrap.cli.main import main
+    from flagwrap.io.runfile import write_dataset_atomic
+
+    cfgp = tmp_path / "t.toml"
+    cfgp.write_text(tiny_toml(ccw=0.2, cw=0.2))
+    out = tmp_path / "t.nc"
+    assert main(["run", str(cfgp), "--quiet", "-o", str(out)]) == 0
+    ds = read_run(out)
+    part = ds.isel(time=np.flatnonzero(ds["turns"].values <= 0.15))
+    part.attrs["status"] = "failed"
+    part.attrs["message"] = "t/T=0.15: interrupted (SIGTERM)"
+    write_dataset_atomic(part, out)
+    capsys.readouterr()
+    assert main(["analyze", str(out), "--no-write"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "partial run (t/T=0.15: interrupted (SIGTERM))" in err[0]
+    assert "--resume" in err[0]

@@ -77,6 +77,12 @@ def analyze_dataset(ds, analysis: BucklingAnalysis | None = None,
             om = own
         else:
             a.motor_reversed = False
+    if ds.attrs.get("status") == "failed" and not (om < 0).any():
+        # a partial file (Ctrl-C, SIGTERM, a failure) that stopped before the reversal
+        raise UserInputError(
+            f"this is a partial run ({ds.attrs.get('message', 'stopped early')}) that ended "
+            f"in the CCW phase, at turn {float(ds['turns'].values[-1]):.3g}: there is no CW "
+            "phase to analyse yet (`flagwrap run ... --resume` continues it)")
     return a.compute(ds["turns"].values, x, om,
                      float(ds.attrs["length"]), cfg.body.resolved_radius(R),
                      cfg.body.resolved_length(R), tq, body_shape=cfg.body.shape)

@@ -113,6 +113,29 @@ def atomic_write(path, write, sync_dir: bool = False) -> Path:
     return path
 
 
+#: files up to this size are built in memory and written as bytes (:func:`write_image`)
+IMAGE_MAX = 1 << 30
+
+
+def write_image(path, build, size_hint: int = 0, sync_dir: bool = False) -> Path:
+    """Create ``path`` atomically from an HDF5 file that ``build(target)`` writes: into memory
+    (an ``io.BytesIO``), then its bytes to the temporary file, when ``size_hint`` is at most
+    :data:`IMAGE_MAX`; straight to the temporary file otherwise.
+
+    Why: HDF5 fails badly when the disk fills or a file-size limit (``ulimit -f``) stops a
+    write inside it: h5py raises from a destructor and the process dies by a signal (measured:
+    exit -11, nothing kept). Built in memory, the file's bytes reach the disk by plain writes,
+    whose failure is a clean ``OSError`` (ENOSPC, EFBIG) that the callers report and rescue."""
+    if size_hint > IMAGE_MAX:
+        return atomic_write(path, build, sync_dir=sync_dir)
+    import io
+
+    buf = io.BytesIO()
+    build(buf)
+    data = buf.getbuffer()
+    return atomic_write(path, lambda tmp: tmp.write_bytes(data), sync_dir=sync_dir)
+
+
 def read_error(path, what: str, exc: BaseException) -> str:
     """One-line message for a file that could not be read: a failed checksum (HDF5's
     Fletcher-32 filter reports "filter returned failure" / "checksum") is called corrupt, any

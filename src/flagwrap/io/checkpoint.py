@@ -35,7 +35,7 @@ import numpy as np
 
 from flagwrap import __version__
 from flagwrap.errors import UserInputError
-from flagwrap.io.atomic import atomic_write
+from flagwrap.io.atomic import write_image
 
 #: 2: the joint records (hook_angle, hook_torque, hook_twist_torque) and interaction_energy;
 #: 3: solver_memory
@@ -106,7 +106,9 @@ def write_checkpoint(ckpt: Checkpoint, path) -> Path:
             for k in RECORD_NAMES + tuple(k for k in OPTIONAL_RECORD_NAMES if k in ckpt.records):
                 _checked(g, k, ckpt.records[k])
 
-    return atomic_write(path, write, sync_dir=True)
+    size = sum(np.asarray(getattr(ckpt, k)).nbytes for k in ("y", "base_t", "base_d1", "base_rt"))
+    size += sum(np.asarray(v).nbytes for v in ckpt.records.values())
+    return write_image(path, write, size_hint=size, sync_dir=True)
 
 
 def read_checkpoint(path) -> Checkpoint:

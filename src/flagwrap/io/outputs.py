@@ -123,6 +123,7 @@ def write_or_rescue(write, path, what: str = "result"):
         try:
             write(Path(rescue))
         except OSError as exc2:
+            Path(rescue).unlink(missing_ok=True)
             raise OutputWriteError(f"could not write the {what} to {path} ({exc.strerror or exc}) "
                                  f"nor to {rescue} ({exc2.strerror or exc2}); it is lost") from None
         raise OutputWriteError(f"could not write the {what} to {path} ({exc.strerror or exc}); it "

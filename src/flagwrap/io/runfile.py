@@ -168,9 +168,11 @@ def trajectory_dataset(traj):
 
 def write_dataset_atomic(ds, path) -> Path:
     """Write an xarray dataset to ``path`` atomically (see :mod:`flagwrap.io.atomic`)."""
-    from flagwrap.io.atomic import atomic_write
+    from flagwrap.io.atomic import write_image
 
-    return atomic_write(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf", encoding=checksummed(ds)))
+    return write_image(path, lambda target: ds.to_netcdf(target, engine="h5netcdf",
+                                                         encoding=checksummed(ds)),
+                       size_hint=int(ds.nbytes))
 
 
 def checksummed(ds) -> dict:
