@@ -1012,6 +1012,11 @@ class Config:
             from flagwrap.system.parts import check_flagella
 
             check_flagella(self)
+        if not self.initial.perturbation <= 0.5 * fil.length:
+            raise UserInputError(
+                f"initial.perturbation (--perturb) = {self.initial.perturbation:g} m must be at "
+                f"most half the "
+                f"filament (0.5 L = {0.5 * fil.length:g} m): it is a seed displacement, meant small")
         if self.clamp.lead == "connector":
             from flagwrap.system.parts import check_connector
 
@@ -1083,8 +1088,22 @@ class Config:
         if not sp < rc:
             raise UserInputError(f"body.blob_spacing = {sp:g} m must be smaller than the body "
                                  f"radius {rc:g} m")
-        blobs, _ = cell_body_blobs(self)
+        from flagwrap.body.shapes import config_shape
         from flagwrap.body.solver import AUTO_DIRECT_MAX
+
+        # the count from the surface's area first: building ~1e14 blobs would not end
+        mesh = config_shape(self, unit=1.0).surface_mesh()
+        if mesh is not None:
+            v, tri = mesh
+            area = 0.5 * float(np.linalg.norm(np.cross(v[tri[:, 1]] - v[tri[:, 0]],
+                                                       v[tri[:, 2]] - v[tri[:, 0]]), axis=1).sum())
+            estimate = area / (sp * sp)
+            if estimate > 4 * MAX_BLOBS_KRYLOV:
+                raise UserInputError(
+                    f"body.blob_spacing = {sp:g} m would put ~{estimate:.2g} blobs on the body "
+                    f"(area {area:.3g} m^2), more than any solve takes ({MAX_BLOBS_KRYLOV}); use "
+                    f"a spacing >= {sp * math.sqrt(estimate / MAX_BLOBS_KRYLOV):.3g} m")
+        blobs, _ = cell_body_blobs(self)
 
         direct = b.solver == "direct" or (b.solver == "auto" and len(blobs) <= AUTO_DIRECT_MAX)
         most = MAX_BLOBS if direct else MAX_BLOBS_KRYLOV

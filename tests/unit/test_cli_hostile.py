@@ -76,6 +76,11 @@ def make_world(d: Path) -> Path:
     (d / "nomotor.toml").write_text(tiny_toml().replace('"ccw"', '"stop"').replace('"cw"', '"stop"')
                                     + swim)
     (d / "freeclear.toml").write_text(tiny_toml() + "\n[body]\nmotion = 'free'\n")
+    # issue 33, item 5/6: a quoted number, a perturbation of 1e300 m, ~1e17 blobs
+    (d / "hookstr.toml").write_text(tiny_toml() + "\n[joint]\nkind = 'hook'\nhook_length = 0.004\n"
+                                    "hook_bending_modulus = '0.1'\n")
+    (d / "blobs1e17.toml").write_text(tiny_toml() + "\n[body]\nsurface = 'no-slip'\n"
+                                      "blob_spacing = 1e-9\n")
     (d / "big.toml").write_text("name = 'big'\n[grid]\npsi_deg = [" + ", ".join(str(30 + 0.01 * i) for i in range(1000))
                                 + "]\nturns = [" + ", ".join(str(1.5 + 0.001 * i) for i in range(1000)) + "]\nmachin = 100.0\n")
     return d
@@ -150,6 +155,12 @@ HOSTILE = [
     (["run", "{d}/nomotor.toml", "-o", "{d}/new.nc", "--quiet"], "needs a motor that turns"),
     (["run", "{d}/freeclear.toml", "-o", "{d}/new.nc", "--quiet"], "needs body.surface = 'no-slip'"),
     (["stability", "{d}/stall.toml"], "motor.stall_torque"),
+    # issue 33, items 5 and 6 (a traceback, a crash, a hang before)
+    (["run", "{d}/hookstr.toml", "-o", "{d}/new.nc", "--quiet"],
+     "joint.hook_bending_modulus must be a number, got '0.1'"),
+    (["run", "{d}/tiny.toml", "--perturb", "1e300", "-o", "{d}/new.nc", "--quiet"],
+     "initial.perturbation (--perturb)"),
+    (["run", "{d}/blobs1e17.toml", "-o", "{d}/new.nc", "--quiet"], "body.blob_spacing = 1e-09 m"),
 ]
 
 

@@ -75,6 +75,18 @@ def _check_types(section: str, cls, table: dict):
             raise UserInputError(f"{section}.{key} must be a single value, got {type(value).__name__}")
         if isinstance(value, float) and not math.isfinite(value):
             raise UserInputError(f"{section}.{key} must be finite, got {value}")
+        # the field's declared kind: a quoted number or a number where a name belongs is
+        # refused here, by name, before it reaches arithmetic
+        kind = str(known[key].type)
+        if kind in ("float", "float | None", "int") and not _is_number(value):
+            raise UserInputError(f"{section}.{key} must be a number, got {_show(value)} "
+                                 f"({type(value).__name__})")
+        if kind == "int" and not isinstance(value, int):
+            raise UserInputError(f"{section}.{key} must be an integer, got {value!r}")
+        if kind == "str" and not isinstance(value, str):
+            raise UserInputError(f"{section}.{key} must be a name (a string), got {value!r}")
+        if kind == "bool" and not isinstance(value, bool):
+            raise UserInputError(f"{section}.{key} must be true or false, got {_show(value)}")
 
 
 def _is_number(v) -> bool:
