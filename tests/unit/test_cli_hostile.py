@@ -81,6 +81,9 @@ def make_world(d: Path) -> Path:
                                     "hook_bending_modulus = '0.1'\n")
     (d / "blobs1e17.toml").write_text(tiny_toml() + "\n[body]\nsurface = 'no-slip'\n"
                                       "blob_spacing = 1e-9\n")
+    (d / "notutf8.toml").write_bytes(b"\xff\xfe\x00[[species]]")
+    (d / "spints.toml").write_text("species = [1, 2]\n")
+    (d / "sphuge.toml").write_text("[[species]]\nkey = 'x'\nradius_um = 1e300\n")
     (d / "big.toml").write_text("name = 'big'\n[grid]\npsi_deg = [" + ", ".join(str(30 + 0.01 * i) for i in range(1000))
                                 + "]\nturns = [" + ", ".join(str(1.5 + 0.001 * i) for i in range(1000)) + "]\nmachin = 100.0\n")
     return d
@@ -161,6 +164,13 @@ HOSTILE = [
     (["run", "{d}/tiny.toml", "--perturb", "1e300", "-o", "{d}/new.nc", "--quiet"],
      "initial.perturbation (--perturb)"),
     (["run", "{d}/blobs1e17.toml", "-o", "{d}/new.nc", "--quiet"], "body.blob_spacing = 1e-09 m"),
+    (["bacteria", "--file", "{d}/notutf8.toml"], "is not a UTF-8 text file"),
+    (["bacteria", "--file", "{d}/adir"], "is a directory"),
+    (["bacteria", "--file", "{d}/spints.toml"], "species[0] must be a table"),
+    (["bacteria", "--file", "{d}/sphuge.toml"], "radius_um = 1e+300 is not a physical value"),
+    (["sweep", "{d}/big.toml", "--scheduler", "tcp://127.0.0.1:notaport", "--out", "{d}/sw"],
+     "--scheduler must be"),
+    (["sweep", "{d}/big.toml", "--scheduler", "inproc://x", "--out", "{d}/sw"], "--scheduler must be"),
 ]
 
 

@@ -220,12 +220,18 @@ def parse_species(document: Mapping[str, Any], origin: str = "<toml>") -> list[S
 
     Each parameter is a number or a table ``{value, status, source, note}``.
     """
-    defaults = dict(document.get("defaults", {}))
+    defaults = document.get("defaults", {})
+    if not isinstance(defaults, Mapping):
+        raise UserInputError(f"{origin}: [defaults] must be a table")
+    defaults = dict(defaults)
     entries = document.get("species")
     if not isinstance(entries, list) or not entries:
         raise UserInputError(f"{origin}: needs at least one [[species]] table")
     out = []
-    for raw in entries:
+    for k, raw in enumerate(entries):
+        if not isinstance(raw, Mapping):
+            raise UserInputError(f"{origin}: species[{k}] must be a table ([[species]]), got "
+                                 f"{raw!r}")
         key = str(raw.get("key", "")).strip()
         if not key:
             raise UserInputError(f"{origin}: every [[species]] needs a non-empty 'key'")
@@ -260,6 +266,9 @@ def parse_species(document: Mapping[str, Any], origin: str = "<toml>") -> list[S
                 raise UserInputError(f"{origin}: species {key!r}: {fname} must be a number, got {value!r}")
             else:
                 value = float(value)
+                if not math.isfinite(value) or abs(value) > 1e12:
+                    raise UserInputError(f"{origin}: species {key!r}: {fname} = {value!r} is "
+                                         "not a physical value (finite, below 1e12 in its unit)")
             kwargs[fname] = value
         out.append(Species(**kwargs, provenance=prov))
     keys = [s.key for s in out]
@@ -283,6 +292,12 @@ def load_species_file(path: str | Path) -> list[Species]:
         doc = tomllib.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise UserInputError(f"species file not found: {p}") from None
+    except IsADirectoryError:
+        raise UserInputError(f"--file {p} is a directory, not a species TOML file") from None
+    except UnicodeDecodeError:
+        raise UserInputError(f"--file {p} is not a UTF-8 text file (a species TOML)") from None
+    except OSError as exc:
+        raise UserInputError(f"--file {p} cannot be read: {exc.strerror or exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise UserInputError(f"{p}: invalid TOML: {exc}") from None
     return parse_species(doc, str(p))

@@ -40,11 +40,12 @@ def run(args) -> int:
     from flagwrap.sweep.spec import load_spec
     from flagwrap.sweep.store import SweepStore
 
-    spec = load_spec(args.spec)
     sched = args.scheduler
-    if sched not in ("local", "synchronous") and not re.fullmatch(r"[a-z]+://\S+|[^\s:/]+:\d+", sched):
+    if sched not in ("local", "synchronous") and not re.fullmatch(
+            r"(tcp|tls|ws|wss|ucx)://[^\s:/]+:\d{1,5}|[^\s:/]+:\d{1,5}", sched):
         raise UserInputError(f"--scheduler must be 'local', 'synchronous' or a Dask scheduler "
                              f"address like tcp://HOST:PORT, got {sched!r}")
+    spec = load_spec(args.spec)
     if args.workers is not None and args.workers < 1:
         raise UserInputError(f"--workers must be >= 1, got {args.workers}")
     from flagwrap.io.outputs import check_output_dir
