@@ -171,6 +171,9 @@ HOSTILE = [
     (["sweep", "{d}/big.toml", "--scheduler", "tcp://127.0.0.1:notaport", "--out", "{d}/sw"],
      "--scheduler must be"),
     (["sweep", "{d}/big.toml", "--scheduler", "inproc://x", "--out", "{d}/sw"], "--scheduler must be"),
+    (["theory", "stretch", "--radius", "1e300"], "--radius must be in"),
+    (["theory", "stretch", "--youngs-modulus", "1e300"], "--youngs-modulus must be in"),
+    (["theory", "stretch", "-o", "{d}/afile/s.csv"], "is a file, not a folder"),
 ]
 
 

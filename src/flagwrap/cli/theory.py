@@ -63,9 +63,24 @@ def run(args: argparse.Namespace) -> int:
 
     if not 2 <= args.points <= MAX_POINTS:
         raise UserInputError(f"--points must be in [2, {MAX_POINTS}], got {args.points}")
+    # physical ranges (a molecule to a lab tank; a gel to steel), so that no value overflows
+    for opt, v, lo, hi in (("--radius", args.radius, 1e-9, 10.0), ("--pitch", args.pitch, 1e-9, 10.0),
+                           ("--length", args.length, 1e-9, 100.0), ("--a", args.a, 1e-10, 1.0),
+                           ("--b", args.b, 1e-10, 1.0),
+                           ("--youngs-modulus", args.youngs_modulus, 1.0, 1e13)):
+        if not (v is not None and math.isfinite(v) and lo <= v <= hi):
+            raise UserInputError(f"{opt} must be in [{lo:g}, {hi:g}] (SI), got {v!r}")
+    if args.output is not None:
+        from flagwrap.io.outputs import check_output_file
+
+        check_output_file(args.output, "-o", suffixes=(".csv", ".txt"))
     b = None if args.b == args.a else args.b
     h = StretchedHelix(args.radius, args.pitch, args.length, args.youngs_modulus, args.poisson, args.a, b)
     psi = np.linspace(h.psi0, math.radians(5.0), args.points)
     z, F = h.force_extension(psi, axial_stretch=not args.no_axial_stretch)
-    write_csv({"psi_deg": np.degrees(psi), "z_over_L": z, "F_N": F, "F_reduced": F / h.force_scale}, args.output)
+    cols = {"psi_deg": np.degrees(psi), "z_over_L": z, "F_N": F, "F_reduced": F / h.force_scale}
+    if not all(np.all(np.isfinite(c)) for c in cols.values()):
+        raise UserInputError("these inputs give a force-extension curve that is not finite "
+                             "(--radius, --pitch, --length, --youngs-modulus, --a, --b)")
+    write_csv(cols, args.output)
     return 0
