@@ -76,15 +76,21 @@ class RunResult:
 
 
 def run(config, output=None, figure=None, hydrodynamics=None, integrator=None,
-        progress: bool = False) -> RunResult:
+        progress: bool = False, precise: bool = False) -> RunResult:
     """``flagwrap run``: simulate ``config``'s protocol; write the run file to ``output`` (and
-    a summary figure to ``figure``) if given. The same output checks and lock as the command."""
+    a summary figure to ``figure``) if given. The same output checks and lock as the command.
+    ``precise``: ``--precise`` (``numerics.tol`` at most 1e-6, for quoting mean rates)."""
+    import dataclasses
+
+    from flagwrap.cli.run import PRECISE_TOL
     from flagwrap.io.outputs import check_output_file, output_lock, write_or_rescue
     from flagwrap.io.runfile import write_run
     from flagwrap.resources import check_disk, check_memory
     from flagwrap.simulation import simulate
 
     cfg = _with_numerics(load(config), hydrodynamics, integrator)
+    if precise and cfg.numerics.tol > PRECISE_TOL:
+        cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, tol=PRECISE_TOL))
     check_memory(cfg)
     out = None
     if output is not None:

@@ -106,3 +106,22 @@ def test_a_header_above_the_scaling_line_says_where_this_models_threshold_is(tmp
     assert main(["run", str(cfgp), "--quiet", "--turns", "0.01", "0", "-o",
                  str(tmp_path / "b.nc")]) == 0
     assert "against the paper's scaling line" not in capsys.readouterr().err
+
+
+def test_precise_is_the_rates_preset_in_the_command_and_the_api(tmp_path, capsys):
+    # --precise tightens numerics.tol to 1e-6 (never loosens it), stored with the run; the
+    # API's run(precise=True) is the same
+    import flagwrap
+    from flagwrap.cli.main import main
+    from flagwrap.io.runfile import config_of, read_run
+
+    cfg = tmp_path / "t.toml"
+    cfg.write_text(tiny_toml(ccw=0.1, cw=0.05))
+    assert main(["run", str(cfg), "--quiet", "--precise", "-o", str(tmp_path / "p.nc")]) == 0
+    assert config_of(read_run(tmp_path / "p.nc")).numerics.tol == 1e-6
+    tight = tmp_path / "tight.toml"
+    tight.write_text(tiny_toml(ccw=0.1, cw=0.05).replace("tol = 1e-3", "tol = 1e-8"))
+    assert main(["run", str(tight), "--quiet", "--precise", "-o", str(tmp_path / "q.nc")]) == 0
+    assert config_of(read_run(tmp_path / "q.nc")).numerics.tol == 1e-8
+    r = flagwrap.run(str(cfg), output=tmp_path / "a.nc", precise=True)
+    assert config_of(read_run(tmp_path / "a.nc")).numerics.tol == 1e-6 and r is not None
