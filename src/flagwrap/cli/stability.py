@@ -102,15 +102,18 @@ def run(args) -> int:
     m_max = resolve_m_max(cfg, args.m_start, args.m_max)
     progress = not (args.json or args.no_progress)
     bar = _bar(progress and sys.stderr.isatty(), args.m_start, m_max)
-    if progress:  # what it is doing, from the first second (a log line per state off a TTY)
-        import time
+    import time
 
-        t0 = time.perf_counter()
-        fil = cfg.filament
-        body = (f", a {cfg.body.motion} no-slip body" if cfg.body.no_slip else "")
-        print(f"flagwrap stability {cfg.name}: {fil.n_beads} beads{body}; following the steady "
-              f"{args.direction.upper()} whirl from M = {args.m_start:g} up to {m_max:.4g} "
-              "(each state: Newton, then the leading eigenvalues)", file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+
+    def start(m_hi):  # what it is doing, once the system is accepted (a line per state off a TTY)
+        if progress:
+            fil = cfg.filament
+            body = (f", a {cfg.body.motion} no-slip body" if cfg.body.no_slip else "")
+            print(f"flagwrap stability {cfg.name}: {fil.n_beads} beads{body}; following the "
+                  f"steady {args.direction.upper()} whirl from M = {args.m_start:g} up to "
+                  f"{m_hi:.4g} (each state: Newton, then the leading eigenvalues; built in "
+                  f"{time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
 
     def show(p):
         if bar is not None:
@@ -124,7 +127,8 @@ def run(args) -> int:
 
     try:
         res = critical_from_config(cfg, args.direction, m_start=args.m_start, m_max=m_max,
-                                   factor=args.factor, rtol=args.rtol, on_point=show)
+                                   factor=args.factor, rtol=args.rtol, on_point=show,
+                                   on_start=start)
     finally:
         if bar is not None:
             bar.close()

@@ -279,14 +279,15 @@ def check_continuation_options(m_start, m_max, rtol, factor, option=lambda name:
 
 
 def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m_max=None,
-                         **kw) -> StabilityResult:
+                         on_start=None, **kw) -> StabilityResult:
     """:func:`find_critical` for a config: its system, turning at the reference speed in
     ``direction`` ("cw" or "ccw"), from ``m_start`` to ``m_max`` (:func:`resolve_m_max`).
     Refuses a bad range or a system the turning frame does not fit before any work.
 
     A torque motor (``motor.kind`` "torque" or "torque-speed") is replaced by a speed motor
     at its reference frequency for the threshold, and the result gets ``res.motor``
-    (:func:`motor_verdict`): whether that motor can drive the whirl past it."""
+    (:func:`motor_verdict`): whether that motor can drive the whirl past it. ``on_start(m_max)``
+    is called once the system is built and accepted (a progress display's first line)."""
     import dataclasses
 
     drive = None
@@ -296,6 +297,8 @@ def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m
                                                           zero_load_speed=None))
     m_max = resolve_m_max(config, m_start, m_max)
     frame = make_frame(config, DIRECTIONS[direction])
+    if on_start is not None:  # the system is built and fits the turning frame
+        on_start(m_max)
     res = find_critical(frame, m_start=m_start, m_max=m_max, omega_si=config.omega,
                         machin_si=config.machin, **kw)
     if drive is not None:
