@@ -327,5 +327,5 @@ def format_table(species: list[Species], prefactor: float = M_C_PREFACTOR) -> st
             f" {s.instability_ratio(prefactor):>7.3g} {side:<8} {(s.paper_side or '-') + flag:<8}"
         )
     lines.append(f"M = eta (2 pi f) L^4 / A, A = n pi E a^4/4; M_c = {prefactor:g} (R/L)^-3.")
-    lines.append("* = assumption (not printed in the seed for this species); ! = disagrees with the paper.")
+    lines.append("* = assumption (not printed in the paper for this species); ! = disagrees with the paper.")
     return "\n".join(lines)
