@@ -103,3 +103,24 @@ def test_progress_from_the_first_second_off_a_terminal(tiny, capsys):
     for quiet in (["--no-progress"], ["--json"]):
         main(["stability", str(tiny / "tiny.toml"), "--m-max", "40", *quiet])
         assert capsys.readouterr().err == ""
+
+
+def test_the_threshold_torque_and_onset_prefactor_are_reported(tiny, capsys):
+    # issue 29, items 3-4: the whirl's motor torque at M_c in A/R and SI, and the linear
+    # waiting-time prefactor, in the JSON and the text, consistent with each other
+    import math
+
+    from flagwrap.cli.main import main
+    from flagwrap.io.config import load_config
+
+    assert main(["stability", str(tiny / "tiny.toml"), "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    fil = load_config(tiny / "tiny.toml").filament
+    assert s["torque_c"] == pytest.approx(s["torque_c_reduced"] * fil.bending_modulus
+                                          / fil.helix_radius, rel=1e-12)
+    assert s["growth_slope"] > 0 and s["onset_prefactor"] == pytest.approx(
+        math.log(150) / (2 * math.pi * s["growth_slope"]))
+    assert main(["stability", str(tiny / "tiny.toml"), "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert f"motor torque of the whirl at M_c: {s['torque_c_reduced']:.3f} A/R" in out
+    assert f"t_c/T ~ {s['onset_prefactor']:.2f}/eps" in out

@@ -263,3 +263,26 @@ def test_a_lost_branch_keeps_the_states_that_converged(monkeypatch):
     assert sorted(exc.states) == [100.0, 250.0]
     assert all(st.converged for st in exc.states.values())
     assert exc.state.machin == pytest.approx(300.0, rel=1e-2) and exc.m_failed > 300.0
+
+
+def test_growth_slope_is_the_leading_eigenvalues_derivative_in_eps(cw31):
+    # the slope from the bracket's two states against central differences of the leading
+    # eigenvalue's real part from two steady states solved afresh at M_c (1 +- 2 %): Re is
+    # smooth in M through a Hopf, so they agree to its curvature over the step (measured
+    # 0.38244 against 0.38327, 0.2 %)
+    import math
+
+    from flagwrap.stability.threshold import onset_prefactor
+
+    frame, r = cw31
+    assert r.growth_slope > 0
+    res = []
+    for f in (0.98, 1.02):
+        st = newton(frame, r.machin_c * f, r.state.z, r.state.base)
+        res.append(spectrum(frame, st).leading.real)
+    fd = (res[1] - res[0]) / math.log(1.02 / 0.98)
+    assert r.growth_slope == pytest.approx(fd, rel=0.01)
+    # the waiting-time prefactor: ln(rise/seed) / (2 pi s), the formula itself
+    assert onset_prefactor(r.growth_slope) == pytest.approx(
+        math.log(150.0) / (2 * math.pi * r.growth_slope))
+    assert math.isnan(onset_prefactor(-1.0)) and math.isnan(onset_prefactor(0.5, seed=0.2))

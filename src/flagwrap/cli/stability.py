@@ -133,10 +133,16 @@ def run(args) -> int:
         if bar is not None:
             bar.close()
     files = _write_mode(res, cfg, args)
+    from flagwrap.stability.threshold import onset_prefactor, whirl_torque
+
+    fil = cfg.filament
+    t_core = whirl_torque(res) if res.converged else math.nan  # units of A/L
     s = res.summary()
     s.update(config=str(args.config), hydrodynamics=cfg.numerics.hydrodynamics,
              machin_critical_scaling=cfg.machin_critical_scaling, m_start=args.m_start,
-             m_max=m_max, files=files)
+             m_max=m_max, files=files, onset_prefactor=onset_prefactor(res.growth_slope),
+             torque_c_reduced=t_core * fil.helix_radius / fil.length,
+             torque_c=t_core * fil.bending_modulus / fil.length)
     if args.json:
         from flagwrap.sweep.store import jsonable
 
@@ -168,6 +174,15 @@ def run(args) -> int:
     print(f"steady shape at M_c: free end {(tip - res.tip_z0):+.4f} L above its rest height "
           f"({(tip - res.tip_z0) * L * scale:+.3g} {unit})")
     print(f"M_c / scaling line 0.06 (R/L)^-3 = {res.machin_c / cfg.machin_critical_scaling:.2f}")
+    tq = s["torque_c"]
+    si = f"{tq * 1e21:.4g} pN nm" if L < 1e-3 else f"{tq:.3g} N m"  # a bacterium or the rig
+    print(f"motor torque of the whirl at M_c: {s['torque_c_reduced']:.3f} A/R = {si} (the "
+          "paper's scaling estimate: N_c ~ 0.5 A/R)")
+    if res.growth_slope > 0:
+        print(f"growth above M_c: d Re(lambda)/d eps = {res.growth_slope:.3g} omega (eps = "
+              f"M/M_c - 1): a 1e-3 L seed grows to the 0.15 L rise in t_c/T ~ "
+              f"{s['onset_prefactor']:.2f}/eps by linear growth (the paper's Fig. 6: 0.5/eps; a "
+              "saturating Hopf cycle may never reach the rise: docs/stability.md)")
     if res.motor is not None:
         print(_motor_line(res.motor))
     for f in files:

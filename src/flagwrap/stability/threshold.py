@@ -74,6 +74,9 @@ class StabilityResult:
     frame: object = field(default=None, repr=False)  # the RotatingFrame it was computed in
     wall_time: float = 0.0
     motor: dict | None = None  # a torque motor's verdict (motor_verdict), else None
+    #: d Re(lambda) / d eps at M_c, eps = M/M_c - 1 (units of omega): how fast the critical
+    #: mode grows just above the threshold (a crossing by an eigenvalue; nan at a fold)
+    growth_slope: float = math.nan
 
     def summary(self) -> dict:
         return {
@@ -85,6 +88,7 @@ class StabilityResult:
             "mode_frequency_si": self.mode_frequency * self.omega_c,
             "tip_z0": self.tip_z0, "wall_time": self.wall_time,
             "branch": [p.as_dict() for p in self.branch], "motor": self.motor,
+            "growth_slope": self.growth_slope,
         }
 
 
@@ -188,6 +192,8 @@ def _refine(frame, res, lo, plo, hi, phi, rtol, record) -> None:
     res.machin_c = math.exp((1 - w) * math.log(lo.machin) + w * math.log(hi.machin))
     res.bracket = (lo.machin, hi.machin)
     res.eigenvalue = phi.leading
+    if b != a:  # d Re / d ln M across the bracket, = d Re / d eps at M_c
+        res.growth_slope = (b - a) / math.log(hi.machin / lo.machin)
     res.crossing = "steady" if phi.leading.imag == 0.0 else "hopf"
     res.mode_frequency = abs(phi.leading.imag)
     res.state = hi
@@ -304,6 +310,18 @@ def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m
     if drive is not None:
         res.motor = motor_verdict(drive, config, res)
     return res
+
+
+def onset_prefactor(growth_slope: float, seed: float = 1e-3, rise: float = 0.15) -> float:
+    """``C`` of the waiting time ``t_c/T ~ C/eps`` just above the threshold, from the linear
+    growth alone: the critical mode grows by ``exp(2 pi Re(lambda))`` a motor turn
+    (``lambda`` in units of omega) and ``Re(lambda) ~ s eps`` (``s`` = ``growth_slope``), so a
+    seed of amplitude ``seed`` reaches ``rise`` (both in L, the paper's rise criterion 0.15 L)
+    after ``ln(rise/seed) / (2 pi s eps)`` turns. An upper bound on how fast the paper's
+    criterion can fire: a supercritical Hopf cycle that saturates below ``rise`` never does."""
+    if not (growth_slope > 0 and 0 < seed < rise):
+        return math.nan
+    return math.log(rise / seed) / (2 * math.pi * growth_slope)
 
 
 def whirl_torque(res) -> float:
