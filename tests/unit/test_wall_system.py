@@ -29,6 +29,7 @@ KINDS = {
     "no hydrodynamics (contact only)": ("hydrodynamics = false\n", ""),
     "tube chain": ("", "", "hydrodynamic_model = 'tube'\n"),
     "fixed no-slip body": ("", BODY),
+    "free cell": ("", BODY + "motion = 'free'\n"),
 }
 
 
@@ -52,6 +53,8 @@ def test_every_kind_of_system_runs_beside_a_wall(kind, tmp_path):
     m = s.mobility.inner if isinstance(s.mobility, TubeMobility) else s.mobility
     if not cfg.numerics.hydrodynamics:
         assert type(m).__name__ == "LocalMobility"
+    elif cfg.body.free:  # the swimmer carries the wall itself (its blobs move against it)
+        assert s.wall is not None and np.allclose(s.wall.normal, [-1.0, 0.0, 0.0])
     elif cfg.body.no_slip:
         assert m.wall is s.wall and isinstance(m._free, WallMobility)
     else:
@@ -190,7 +193,8 @@ REFUSED = {
     "body across": ("[[wall]]\npoint = [0.0, 0, 0.05]\nnormal = [0.0, 0, -1.0]\n", "", "",
                     "cell body crosses the wall"),
     "two walls": (SIDE + SIDE.replace("0.08", "0.09"), "", "", "one wall is supported"),
-    "free body": (SIDE, "", BODY + "motion = 'free'\n", "body.motion = 'free'"),
+    "free body, krylov blobs": (SIDE, "", BODY + "motion = 'free'\nsolver = 'krylov'\n",
+                                "body.solver = 'direct'"),
     "turning frame, side wall": (SIDE, "frame = 'rotating'\n", "", "numerics.frame = 'rotating'"),
     "unknown key": ("[[wall]]\npoint = [0.08, 0, 0]\nnormal = [-1, 0, 0]\nradius = 1\n", "", "",
                     "unknown key wall[0].radius"),
@@ -244,3 +248,90 @@ def test_analyze_reports_the_gap_to_the_wall(tmp_path, capsys):
     assert res["wall"]["gap_final"] == pytest.approx(gap[-1].min(), rel=1e-12)
     assert main(["analyze", str(out), "--no-write"]) == 0
     assert "wall: closest bead surface" in capsys.readouterr().out
+
+
+FREE_SPHERE = ("[body]\nsurface = 'no-slip'\nshape = 'sphere'\nradius = 0.05\n"
+               "blob_spacing = 0.012\nmotion = 'free'\n")
+
+
+@pytest.mark.parametrize("h", [1.5, 2.0, 4.0])
+def test_free_cells_mobility_beside_a_wall_is_brenners(h):
+    # the swimmer's own body mobility at its pose, a 212-blob sphere with a wall above it
+    # (normal along the body axis: no rotation couples in), against Brenner's exact normal
+    # drag at the blob sphere's radius R_t; measured 6e-5 to 1.4e-4 (64 blobs: 2.3e-3)
+    from flagwrap.body.multiblob import effective_radii
+    from flagwrap.simulation import make_system
+    from flagwrap.theory.wall_drag import brenner_normal
+
+    base = make_system(config_from_dict(tomllib.loads(tiny_toml() + FREE_SPHERE)))
+    L = base.config.filament.length
+    Rt, _ = effective_radii(base.blobs - [0.0, 0.0, 0.05 / L], base.blob_radii[0])
+    zw = float(0.05 + h * Rt * L)  # the centre is 0.05 m up; the wall h R_t above it
+    wall = f"[[wall]]\npoint = [0.0, 0.0, {zw!r}]\nnormal = [0.0, 0.0, -1.0]\n"
+    s = make_system(config_from_dict(tomllib.loads(tiny_toml() + FREE_SPHERE + wall)))
+    N = s._body(s.initial_y())[2]
+    assert N[2, 2] * 6 * math.pi * Rt == pytest.approx(1 / brenner_normal(h), rel=1e-3)
+    far = make_system(config_from_dict(tomllib.loads(tiny_toml() + FREE_SPHERE + wall.replace(
+        f"{zw!r}", "400.0"))))
+    np.testing.assert_allclose(far._body(far.initial_y())[2], base.body_mobility, rtol=1e-3,
+                               atol=1e-3 * np.abs(base.body_mobility).max())
+
+
+def test_free_cell_far_from_a_wall_swims_as_in_free_space(rng):
+    # a force- and torque-free swimmer's image flow decays fast: 1000 L away its velocities
+    # are free space's to 1e-9 (measured 3.5e-12); 0.2 L away they move by ~1 %
+    from flagwrap.simulation import make_system
+
+    text = tiny_toml() + BODY + "motion = 'free'\n"
+    free = make_system(config_from_dict(tomllib.loads(text)))
+    y = free.initial_y()
+    y[free.sl_x] += 1e-3 * rng.standard_normal(free.sl_x.stop - free.sl_x.start)
+    f0 = free.apply_mobility(y, free.forces(y, free.frames0.copy()).G)
+    for wall, lo, hi in ((SIDE.replace("0.08", "400.0"), 0.0, 1e-9), (SIDE, 1e-3, 0.1)):
+        s = make_system(config_from_dict(tomllib.loads(text + wall)))
+        f = s.apply_mobility(y, s.forces(y, s.frames0.copy()).G)
+        d = np.linalg.norm(f - f0) / np.linalg.norm(f0)
+        assert lo <= d < hi, d
+        A = s.mobility_matrix(y)
+        assert np.abs(A - A.T).max() < 1e-12 * np.abs(A).max()
+
+
+def test_the_walls_push_on_a_free_body_is_its_contact_energys_gradient():
+    # the body's steric load: -dU/dX along the normal by differences of the energy as the
+    # wall moves (U depends on X - p), and no push beyond the cut-off
+    from flagwrap.body import _kernels as BK
+    from flagwrap.hydrodynamics.wall import PlaneWall
+    from flagwrap.simulation import make_system
+
+    s = make_system(config_from_dict(tomllib.loads(tiny_toml() + FREE_SPHERE + (
+        "[[wall]]\npoint = [0.0, 0.0, 0.1]\nnormal = [0.0, 0.0, -1.0]\n"))))
+    y = s.initial_y()
+    cutoff, strength, c2 = s._wall_contact
+    top = float(np.max(s.blobs[:, 2] + s.blob_radii))
+
+    def energy(zwall):
+        d = np.ascontiguousarray(zwall - s.blobs[:, 2] - s.blob_radii)
+        e = np.empty(len(d))
+        BK.wca_law(d, cutoff / 2 ** (1 / 6), strength, c2, e, np.empty(len(d)), np.empty(len(d)))
+        return e.sum()
+
+    z = top + 0.5 * cutoff  # the wall within reach of the top blobs
+    s.wall = PlaneWall([0.0, 0.0, z], [0.0, 0.0, -1.0])
+    s._body_cache = (None, None)
+    load = s.wall_load(y)
+    h = 1e-6 * cutoff
+    dUdz = (energy(z + h) - energy(z - h)) / (2 * h)  # moving the wall up = the body down
+    assert load[2] == pytest.approx(dUdz, rel=1e-5) and load[2] < 0  # pushed away (down)
+    assert np.abs(load[[0, 1, 3, 4, 5]]).max() < 1e-9 * abs(load[2])  # symmetric sphere
+    s.wall = PlaneWall([0.0, 0.0, top + 2 * cutoff], [0.0, 0.0, -1.0])
+    assert np.all(s.wall_load(y) == 0.0)
+
+
+def test_stability_refuses_a_free_cell_beside_a_wall(tmp_path, capsys):
+    from flagwrap.cli.main import main
+
+    path = tmp_path / "f.toml"
+    path.write_text(tiny_toml() + BODY + "motion = 'free'\n" + SIDE)
+    assert main(["stability", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no steady whirl" in err[0]

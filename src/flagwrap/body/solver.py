@@ -42,7 +42,7 @@ class DirectBlobSolver:
     kind = "direct"
     INVERSE_MAX = 1500
 
-    def __init__(self, blobs: np.ndarray, radii: np.ndarray, wall=None):
+    def __init__(self, blobs: np.ndarray, radii: np.ndarray, wall=None, invert: bool = True):
         from scipy.linalg import lapack
 
         Mbb = PolydisperseRPY(radii).matrix(blobs)
@@ -53,7 +53,7 @@ class DirectBlobSolver:
             raise ValueError(f"the blob matrix is not positive definite (LAPACK info {info})")
         self._L = L  # its upper triangle is never read (lower=True everywhere)
         self._inv = None
-        if len(blobs) <= self.INVERSE_MAX:
+        if invert and len(blobs) <= self.INVERSE_MAX:
             inv, info = lapack.dpotri(L, lower=1, overwrite_c=0)
             if info != 0:
                 raise ValueError(f"the blob matrix could not be inverted (LAPACK info {info})")

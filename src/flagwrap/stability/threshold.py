@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from flagwrap.errors import UserInputError
 from flagwrap.stability.spectrum import spectrum
 from flagwrap.stability.steady import BranchLost, NewtonFailure, extrapolate, march, newton, start_state
 
@@ -252,6 +253,10 @@ def make_frame(config, omega: float):
     (:class:`~flagwrap.system.rotating.RotatingFrame`; a fixed no-slip body's blob shell held
     at one angle, ``blob_body``)."""
     if config.body.free:
+        if config.walls:
+            raise UserInputError(
+                "flagwrap stability: a free cell beside a [[wall]] has no steady whirl (it moves "
+                "against the wall); run it in the time domain (flagwrap run)")
         from flagwrap.system.swimmer import SwimmerFrame, make_swimmer
 
         return SwimmerFrame(make_swimmer(config), omega)

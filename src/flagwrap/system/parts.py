@@ -407,8 +407,8 @@ def check_connector(config) -> None:
 
 def check_walls(config) -> None:
     """Refuse ``[[wall]]`` tables that cannot be run (one line naming the key, before any
-    work): more than one wall, a free-swimming body beside one (not built: the swimmer's blobs
-    move against the wall), the turning frame beside a wall not square to the body axis (its
+    work): more than one wall, a free-swimming body beside one with the Krylov blob solver or
+    in the turning frame, the turning frame beside a wall not square to the body axis (its
     symmetry is broken), a filament that starts within its radius of the wall or behind it, a
     body across it."""
     from flagwrap.errors import UserInputError
@@ -419,10 +419,14 @@ def check_walls(config) -> None:
         raise UserInputError(f"{len(walls)} [[wall]] tables: one wall is supported (the "
                              "Rotne-Prager-Blake mobility is a single plane's)")
     w = walls[0]
-    if config.body.free:
-        raise UserInputError("[[wall]] with body.motion = 'free' is not built yet (the "
-                             "swimmer's blobs would move against the wall): hold the body "
-                             "(body.motion = 'fixed') or remove the wall")
+    if config.body.free:  # the swimmer rebuilds its blob matrix per pose (a direct solve)
+        if config.body.solver == "krylov":
+            raise UserInputError("[[wall]] beside a free body needs body.solver = 'direct' or "
+                                 "'auto' (the blob matrix is refactorised at every pose)")
+        if config.numerics.frame != "lab":
+            raise UserInputError(f"[[wall]] beside a free body: numerics.frame = "
+                                 f"{config.numerics.frame!r} has no steady state (the cell moves "
+                                 "against the wall); use numerics.frame = 'lab'")
     if config.numerics.frame != "lab" and math.hypot(*w.normal[:2]) > 1e-12 * math.hypot(*w.normal):
         raise UserInputError(f"[[wall]] with numerics.frame = {config.numerics.frame!r}: a "
                              "wall tilted from the plane z = const breaks the turning frame's "

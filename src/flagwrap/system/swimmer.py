@@ -87,7 +87,8 @@ class SwimmerSystem(RodSystem):
     layout. ``blobs``, ``blob_radii``: the body's surface in body coordinates (core units).
     """
 
-    def __init__(self, system, blobs, blob_radii, solver: str = "direct"):
+    def __init__(self, system, blobs, blob_radii, solver: str = "direct", wall=None,
+                 wall_contact=None):
         from flagwrap.body.solver import make_blob_solver
 
         if not system.mobility.long_range or getattr(system.mobility, "backend", "") != "direct":
@@ -121,6 +122,13 @@ class SwimmerSystem(RodSystem):
             lambda xf: rpy_cross_block(xf, system.radius, self.blobs, self.blob_radii))
         self._geometry_y = None
         self._a_buffers = None
+        #: a no-slip plane (lab frame, core units; :mod:`flagwrap.hydrodynamics.wall`): the
+        #: blobs move against it, so the body's blob matrix, its mobility and every cross
+        #: block depend on the pose and are rebuilt per pose (:meth:`_body`); ``wall_contact``
+        #: ``(cutoff, strength, c2)`` of the body's steric contact with it
+        self.wall = wall
+        self._wall_contact = wall_contact
+        self._body_cache = (None, None)
 
     # state ---------------------------------------------------------------------------------
     def pack(self, x, theta, phi, X=(0.0, 0.0, 0.0), q=(1.0, 0.0, 0.0, 0.0)) -> np.ndarray:
@@ -139,6 +147,52 @@ class SwimmerSystem(RodSystem):
 
     # forces: RodSystem's, in the body frame (nothing depends on the pose: G's pose rows 0)
 
+    # the wall, seen from the body ---------------------------------------------------------
+    def _wall_body(self, y):
+        """The wall in body coordinates at the pose of ``y`` (a
+        :class:`~flagwrap.hydrodynamics.wall.PlaneWall`), or None."""
+        if self.wall is None:
+            return None
+        from flagwrap.hydrodynamics.wall import PlaneWall
+
+        X, R = self.pose(y)
+        return PlaneWall(R.T @ (self.wall.point - X), R.T @ self.wall.normal)
+
+    def _body(self, y):
+        """``(solve, M_bb^-1 K, N, wall)`` at the pose of ``y``: the constant ones without a
+        wall; beside one, ``M_bb + Delta_bb(wall)`` factorised afresh for each new pose (kept
+        for the last pose: a step's stages revisit it)."""
+        if self.wall is None:
+            return self._solver.solve, self._MinvK, self.body_mobility, None
+        key = np.array(y[self.n_in:self.n_in + 7])
+        if self._body_cache[0] is not None and np.array_equal(key, self._body_cache[0]):
+            return self._body_cache[1]
+        from flagwrap.body.solver import DirectBlobSolver
+
+        wb = self._wall_body(y)
+        sol = DirectBlobSolver(self.blobs, self.blob_radii, wall=wb, invert=False)
+        MinvK = sol.solve(self.K)
+        R = self.K.T @ MinvK
+        out = (sol.solve, MinvK, np.linalg.inv(0.5 * (R + R.T)), wb)
+        self._body_cache = (key, out)
+        return out
+
+    def wall_load(self, y) -> np.ndarray:
+        """``[F; T]`` (6,) on the body from its steric contact with the wall (body axes, about
+        the reference point): the filament's contact law on each blob's gap to the plane
+        (its centre's height less its radius), zero without a wall."""
+        if self.wall is None or self._wall_contact is None:
+            return np.zeros(6)
+        from flagwrap.body import _kernels as BK
+
+        cutoff, strength, c2 = self._wall_contact
+        wb = self._wall_body(y)
+        d = np.ascontiguousarray(wb.heights(self.blobs) - self.blob_radii)
+        e, dU, d2U = np.empty(len(d)), np.empty(len(d)), np.empty(len(d))
+        BK.wca_law(d, cutoff / 2.0 ** (1.0 / 6.0), strength, c2, e, dU, d2U)
+        f = -dU[:, None] * wb.normal  # the force on each blob, body axes
+        return np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
+
     # mobility ------------------------------------------------------------------------------
     def _geometry(self, y):
         """Free beads' body-frame positions (nb, 3), free bonds' tangents (ne, 3), ``M_fb``.
@@ -146,7 +200,8 @@ class SwimmerSystem(RodSystem):
         The last state's are kept: a step's stage solver and its first velocity ask at the same
         ``y``, and ``M_fb`` (beads x blobs) is the costliest thing built per call."""
         s = self
-        yin = y[:self.n_in]
+        # beside a wall the cross block depends on the pose too
+        yin = y[:self.n_in] if self.wall is None else y[:self.n_in + 7]
         if self._geometry_y is not None and np.array_equal(yin, self._geometry_y):
             return self._geometry_out
         from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
@@ -160,6 +215,11 @@ class SwimmerSystem(RodSystem):
             e = x[bf + 1] - x[bf]
         t = e / np.linalg.norm(e, axis=1)[:, None]
         rpy_cross_radii(xf, s.radius, self.blobs, self.blob_radii, self._cross)
+        if self.wall is not None:
+            from flagwrap.hydrodynamics.wall import wall_correction_matrix
+
+            self._cross += wall_correction_matrix(self._wall_body(y), xf, s.radius, self.blobs,
+                                                  self.blob_radii)
         self._geometry_y = np.array(yin)
         self._geometry_out = (xf, t, self._cross)
         return self._geometry_out
@@ -188,12 +248,20 @@ class SwimmerSystem(RodSystem):
         """:meth:`body_velocity` and the geometry it used: ``(V, v, lambda, x_free, t)``."""
         s = self
         xf, t, C = self._geometry(y)
+        solve, MinvK, N, wb = self._body(y)
         F = np.asarray(G[s.sl_x]).reshape(-1, 3)
         tau = np.asarray(G[s.sl_th])
-        w = self._solver.solve(C.T @ F.ravel())
-        V = self.body_mobility @ (self.K.T @ w - self._load(xf, t, F, tau))
-        lam = self._MinvK @ V - w
+        w = solve(C.T @ F.ravel())
+        load = self._load(xf, t, F, tau)
+        if wb is not None:  # an external load: the wall's push on the body
+            load = load - self.wall_load(y)
+        V = N @ (self.K.T @ w - load)
+        lam = MinvK @ V - w
         v = s.mobility.apply(xf, F) + (C @ lam).reshape(-1, 3)
+        if wb is not None:
+            from flagwrap.hydrodynamics.wall import wall_correction_apply
+
+            v += wall_correction_apply(wb, xf, s.radius, xf, s.radius, F)
         return V / s.machin, v / s.machin, lam, xf, t
 
     def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
@@ -236,22 +304,30 @@ class SwimmerSystem(RodSystem):
             A.fill(0.0)
         else:
             A, tmp, Mff = np.zeros((self.n_in, self.n_in)), None, None
+        solve, MinvK, N, wb = self._body(y)
         A[:n3, :n3] = s.mobility.matrix(xf, out=Mff)
+        if wb is not None:
+            from flagwrap.hydrodynamics.wall import wall_correction_matrix
+
+            A[:n3, :n3] += wall_correction_matrix(wb, xf, s.radius)
         if screening == "lagged":
             S = self._lagged(xf)
             if S is not None:  # None: a Krylov blob solver, W goes without
                 A[:n3, :n3] -= S
         elif screening:
-            from flagwrap.body.solver import screening_matrix
+            if wb is None:
+                from flagwrap.body.solver import screening_matrix
 
-            A[:n3, :n3] -= screening_matrix(self._solver, C)
+                A[:n3, :n3] -= screening_matrix(self._solver, C)
+            else:  # the pose's own blob matrix
+                A[:n3, :n3] -= C @ solve(C.T)
         idx = np.arange(n3, n3 + s.ne)
         A[idx, idx] = s.twist_mobility * s.machin
         D = np.zeros((6, self.n_in))
         # - S: the beads' rigid-motion matrix transposed, [I; [x]_x] per bead; [0; t] per bond
-        D[:, :n3] = (C @ self._MinvK).T - geometric_matrix(xf).T
+        D[:, :n3] = (C @ MinvK).T - geometric_matrix(xf).T
         D[3:, n3:n3 + s.ne] -= t.T
-        ND = self.body_mobility @ D
+        ND = N @ D
         A += np.matmul(D.T, ND, out=tmp)
         A /= s.machin
         if reuse:  # the body's velocity per generalized force: V = (N D / machin) G
@@ -392,6 +468,14 @@ def make_swimmer(config):
     fil = config.filament
     inner = RodSystem(config, mobility=RPYMobility(fil.bead_radius / fil.length))
     blobs, radii = cell_body_blobs(config)
-    return SwimmerSystem(inner, blobs, radii, solver=config.body.solver)
+    wall = contact = None
+    if config.walls:
+        from flagwrap.hydrodynamics.wall import config_wall
+
+        wall, c = config_wall(config), config.contact
+        contact = (fil.cross_section_radius * (1.0 + c.range) / fil.length,
+                   c.strength / inner.bond, 1.0 if c.potential == "wca-c2" else 0.0)
+    return SwimmerSystem(inner, blobs, radii, solver=config.body.solver, wall=wall,
+                         wall_contact=contact)
 
 
