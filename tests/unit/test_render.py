@@ -119,3 +119,32 @@ def test_summary_figure_marks_the_switch_at_its_time(tiny_run):
     t = ds["turns"].values
     i = find_switch(t, ds["omega"].values)
     assert _switch_turns(ds) == [pytest.approx(t[i - 1])]
+
+
+def test_summary_figure_names_the_phases_the_criterion_and_the_verdict(tiny_run, tmp_path):
+    # issue 34, item 9: each phase named by its motor's sense, the dashed zero line and the
+    # rise criterion in a legend, the verdict in the title (that of `flagwrap analyze`)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flagwrap.analysis.runfile_attrs import analyze_dataset
+    from flagwrap.io.runfile import read_run
+    from flagwrap.plotting import summary
+
+    ds = read_run(tiny_run)
+    captured = {}
+    real_close = plt.close
+    plt.close = lambda fig: captured.setdefault("fig", fig)
+    try:
+        summary.summary_figure(ds, tmp_path / "s.png")
+    finally:
+        plt.close = real_close
+    a1 = captured["fig"].axes[0]
+    texts = [t.get_text() for t in a1.texts]
+    assert texts == ["CCW", "CW"]
+    labels = [t.get_text() for t in a1.get_legend().get_texts()]
+    assert "free end level with the clamp" in labels and any("rise criterion" in x for x in labels)
+    state = analyze_dataset(ds).summary()["state"]
+    assert a1.get_title().endswith(f"final state: {state}")
