@@ -41,3 +41,20 @@ def test_fig3_writes_png_and_pdf(tmp_path, monkeypatch, capsys):
         f = tmp_path / f"fig3.{ext}"
         assert f.exists() and f.stat().st_size > 1000
     assert "fig3.png" in capsys.readouterr().out
+
+
+def test_dry_run_says_which_sweep_results_exist(tmp_path, monkeypatch, capsys):
+    # issue 34, item 9: `figure fig5 --dry-run` names each sweep folder it reads, with its row
+    # count or the command that makes it (a shipped sweep's name, valid from any folder)
+    from flagwrap.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    rows = tmp_path / "out" / "sweeps" / "fig5-quick" / "rows"
+    rows.mkdir(parents=True)
+    for k in range(3):
+        (rows / f"k{k}.json").write_text("{}")
+    assert main(["figure", "fig5", "--dry-run", "-o", str(tmp_path / "figs")]) == 0
+    out = capsys.readouterr().out
+    assert "out/sweeps/fig5-quick: 3 rows" in out
+    assert "out/sweeps/fig5: no results (make them with `flagwrap sweep fig5`" in out
+    assert main(["figure", "fig5", "-o", str(tmp_path / "figs")]) == 2  # rows are not valid

@@ -76,6 +76,9 @@ PLANS = {
                "in out/sweeps/gravity-fig4a and gravity-fig5",
     "hook": "nothing: drawn from the sweep rows in out/sweeps/hook (and hook-grid if present)",
 }
+#: sweep folders a figure is drawn from (names of shipped sweeps: `flagwrap sweep NAME`)
+SWEEPS = {"fig5": ("fig5", "fig5-quick", "fig5-boundary"),
+          "gravity": ("gravity-fig4a", "gravity-fig5"), "hook": ("hook", "hook-grid")}
 #: cache folders a figure reads its runs from
 CACHES = {"fig4": ("out/critical", "out/paper"), "fig6": ("out/critical", "out/waiting"),
           "figS7": ("out/critical", "out/waiting")}
@@ -113,6 +116,13 @@ def run(args: argparse.Namespace) -> int:
     cached = ", ".join(f"{d}: {len(list(Path(d).glob('*.nc')))} cached runs" for d in CACHES.get(args.name, ()))
     print(f"figure {args.name}: {PLANS[args.name]}" + (f" [{cached}]" if cached else "")
           + ("; a run not cached takes ~40 s" if args.name in CACHES else ""), flush=True)
+    if args.name in SWEEPS:  # which sweep results exist, and how to make those that do not
+        for name in SWEEPS[args.name]:
+            rows = Path("out/sweeps") / name / "rows"
+            n = len(list(rows.glob("*.json"))) if rows.is_dir() else 0
+            print(f"  out/sweeps/{name}: " + (f"{n} rows" if n else
+                  f"no results (make them with `flagwrap sweep {name}`, a shipped sweep; "
+                  f"`--dry-run` prices it)"), flush=True)
     if args.dry_run:
         return 0
     try:

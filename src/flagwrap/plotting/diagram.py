@@ -95,7 +95,7 @@ def load_rows(sweep_dirs=None) -> tuple[list[dict], list[str]]:
         if rows:
             return [rows[k] for k in sorted(rows)], used
     raise UserInputError(f"no sweep results in {', '.join(map(str, sum(groups, [])))}: run "
-                         "`flagwrap sweep examples/sweeps/fig5-quick.toml` first")
+                         "`flagwrap sweep fig5-quick` (a shipped sweep, from any folder) first")
 
 
 def classify(row: dict) -> str:
