@@ -306,7 +306,8 @@ def test_the_walls_push_on_a_free_body_is_its_contact_energys_gradient():
     s = make_system(config_from_dict(tomllib.loads(tiny_toml() + FREE_SPHERE + (
         "[[wall]]\npoint = [0.0, 0.0, 0.1]\nnormal = [0.0, 0.0, -1.0]\n"))))
     y = s.initial_y()
-    cutoff, strength, c2 = s._wall_contact
+    wc = s._wall_contact
+    cutoff, strength, c2 = wc.cutoff, wc.strength, wc.c2
     top = float(np.max(s.blobs[:, 2] + s.blob_radii))
 
     def energy(zwall):

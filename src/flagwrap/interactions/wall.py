@@ -15,6 +15,15 @@ import numpy as np
 from flagwrap.body import _kernels as BK
 
 
+def contact_law(config, bond: float) -> tuple[float, float, float]:
+    """``(cutoff, strength, c2)`` of ``[contact]``'s law in core units (``bond``: the
+    filament's bond ``b/L``): what the filament's beads and a free body's blobs meet a wall
+    with, as the beads meet the body."""
+    fil, c = config.filament, config.contact
+    return (fil.cross_section_radius * (1.0 + c.range) / fil.length, c.strength / bond,
+            1.0 if c.potential == "wca-c2" else 0.0)
+
+
 class WallContact:
     """The interaction (:mod:`flagwrap.interactions.base`) of beads ``active`` with the plane
     ``wall`` (:class:`flagwrap.hydrodynamics.wall.PlaneWall`, core units)."""

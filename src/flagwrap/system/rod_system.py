@@ -258,15 +258,13 @@ class RodSystem:
         c = self.config.contact
         out = []
         if self.wall is not None:
-            from flagwrap.interactions.wall import WallContact
+            from flagwrap.interactions.wall import WallContact, contact_law
 
             active = np.ones(self.N, bool)
             for p in self.parts:
                 active[p.bead0:p.bead0 + p.nc] = False
-            fil = self.config.filament
-            out.append(WallContact(self.wall, fil.cross_section_radius * (1.0 + c.range)
-                                   / fil.length, c.strength / self.bond, active,
-                                   c2=1.0 if c.potential == "wca-c2" else 0.0))
+            cutoff, strength, c2 = contact_law(self.config, self.bond)
+            out.append(WallContact(self.wall, cutoff, strength, active, c2=c2))
         if not c.self_contact:
             return out
         from flagwrap.interactions.self_contact import SelfContact, SelfContactInteraction

@@ -125,7 +125,8 @@ class SwimmerSystem(RodSystem):
         #: a no-slip plane (lab frame, core units; :mod:`flagwrap.hydrodynamics.wall`): the
         #: blobs move against it, so the body's blob matrix, its mobility and every cross
         #: block depend on the pose and are rebuilt per pose (:meth:`_body`); ``wall_contact``
-        #: ``(cutoff, strength, c2)`` of the body's steric contact with it
+        #: the body's steric contact with it (a :class:`~flagwrap.interactions.wall.
+        #: WallContact`, whose law acts on the blobs' gaps)
         self.wall = wall
         self._wall_contact = wall_contact
         self._body_cache = (None, None)
@@ -159,11 +160,11 @@ class SwimmerSystem(RodSystem):
         return PlaneWall(R.T @ (self.wall.point - X), R.T @ self.wall.normal)
 
     def _body(self, y):
-        """``(solve, M_bb^-1 K, N, wall)`` at the pose of ``y``: the constant ones without a
-        wall; beside one, ``M_bb + Delta_bb(wall)`` factorised afresh for each new pose (kept
+        """``(blob solver, M_bb^-1 K, N, wall)`` at the pose of ``y``: the constant ones without
+        a wall; beside one, ``M_bb + Delta_bb(wall)`` factorised afresh for each new pose (kept
         for the last pose: a step's stages revisit it)."""
         if self.wall is None:
-            return self._solver.solve, self._MinvK, self.body_mobility, None
+            return self._solver, self._MinvK, self.body_mobility, None
         key = np.array(y[self.n_in:self.n_in + 7])
         if self._body_cache[0] is not None and np.array_equal(key, self._body_cache[0]):
             return self._body_cache[1]
@@ -173,7 +174,7 @@ class SwimmerSystem(RodSystem):
         sol = DirectBlobSolver(self.blobs, self.blob_radii, wall=wb, invert=False)
         MinvK = sol.solve(self.K)
         R = self.K.T @ MinvK
-        out = (sol.solve, MinvK, np.linalg.inv(0.5 * (R + R.T)), wb)
+        out = (sol, MinvK, np.linalg.inv(0.5 * (R + R.T)), wb)
         self._body_cache = (key, out)
         return out
 
@@ -183,13 +184,8 @@ class SwimmerSystem(RodSystem):
         (its centre's height less its radius), zero without a wall."""
         if self.wall is None or self._wall_contact is None:
             return np.zeros(6)
-        from flagwrap.body import _kernels as BK
-
-        cutoff, strength, c2 = self._wall_contact
         wb = self._wall_body(y)
-        d = np.ascontiguousarray(wb.heights(self.blobs) - self.blob_radii)
-        e, dU, d2U = np.empty(len(d)), np.empty(len(d)), np.empty(len(d))
-        BK.wca_law(d, cutoff / 2.0 ** (1.0 / 6.0), strength, c2, e, dU, d2U)
+        _, dU, _ = self._wall_contact.law(wb.heights(self.blobs) - self.blob_radii)
         f = -dU[:, None] * wb.normal  # the force on each blob, body axes
         return np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
 
@@ -248,10 +244,10 @@ class SwimmerSystem(RodSystem):
         """:meth:`body_velocity` and the geometry it used: ``(V, v, lambda, x_free, t)``."""
         s = self
         xf, t, C = self._geometry(y)
-        solve, MinvK, N, wb = self._body(y)
+        solver, MinvK, N, wb = self._body(y)
         F = np.asarray(G[s.sl_x]).reshape(-1, 3)
         tau = np.asarray(G[s.sl_th])
-        w = solve(C.T @ F.ravel())
+        w = solver.solve(C.T @ F.ravel())
         load = self._load(xf, t, F, tau)
         if wb is not None:  # an external load: the wall's push on the body
             load = load - self.wall_load(y)
@@ -304,7 +300,7 @@ class SwimmerSystem(RodSystem):
             A.fill(0.0)
         else:
             A, tmp, Mff = np.zeros((self.n_in, self.n_in)), None, None
-        solve, MinvK, N, wb = self._body(y)
+        solver, MinvK, N, wb = self._body(y)
         A[:n3, :n3] = s.mobility.matrix(xf, out=Mff)
         if wb is not None:
             from flagwrap.hydrodynamics.wall import wall_correction_matrix
@@ -314,13 +310,10 @@ class SwimmerSystem(RodSystem):
             S = self._lagged(xf)
             if S is not None:  # None: a Krylov blob solver, W goes without
                 A[:n3, :n3] -= S
-        elif screening:
-            if wb is None:
-                from flagwrap.body.solver import screening_matrix
+        elif screening:  # with the pose's own blob matrix beside a wall
+            from flagwrap.body.solver import screening_matrix
 
-                A[:n3, :n3] -= screening_matrix(self._solver, C)
-            else:  # the pose's own blob matrix
-                A[:n3, :n3] -= C @ solve(C.T)
+            A[:n3, :n3] -= screening_matrix(solver, C)
         idx = np.arange(n3, n3 + s.ne)
         A[idx, idx] = s.twist_mobility * s.machin
         D = np.zeros((6, self.n_in))
@@ -471,10 +464,11 @@ def make_swimmer(config):
     wall = contact = None
     if config.walls:
         from flagwrap.hydrodynamics.wall import config_wall
+        from flagwrap.interactions.wall import WallContact, contact_law
 
-        wall, c = config_wall(config), config.contact
-        contact = (fil.cross_section_radius * (1.0 + c.range) / fil.length,
-                   c.strength / inner.bond, 1.0 if c.potential == "wca-c2" else 0.0)
+        wall = config_wall(config)
+        cutoff, strength, c2 = contact_law(config, inner.bond)
+        contact = WallContact(wall, cutoff, strength, np.ones(len(blobs), bool), c2=c2)
     return SwimmerSystem(inner, blobs, radii, solver=config.body.solver, wall=wall,
                          wall_contact=contact)
 
