@@ -427,16 +427,18 @@ def check_walls(config) -> None:
             raise UserInputError(f"[[wall]] beside a free body: numerics.frame = "
                                  f"{config.numerics.frame!r} has no steady state (the cell moves "
                                  "against the wall); use numerics.frame = 'lab'")
-    if config.numerics.frame != "lab" and math.hypot(*w.normal[:2]) > 1e-12 * math.hypot(*w.normal):
+    from flagwrap.hydrodynamics.wall import config_wall
+
+    plane = config_wall(config)  # core units
+    if config.numerics.frame != "lab" and not plane.square_to_z:
         raise UserInputError(f"[[wall]] with numerics.frame = {config.numerics.frame!r}: a "
                              "wall tilted from the plane z = const breaks the turning frame's "
                              "symmetry; use numerics.frame = 'lab' (or wall.normal = [0, 0, +-1])")
     fil = config.filament
     L, a = fil.length, fil.cross_section_radius
-    n, p0 = w.unit_normal, np.asarray(w.point, float)
     shape = filament_positions(fil, config.clamp) / L
     for k, pl in enumerate(placements_from_config(config) or [Placement()]):
-        h = float(np.min((pl.apply(shape) * L - p0) @ n))
+        h = float(np.min(plane.heights(pl.apply(shape)))) * L
         if h < a:
             where = f"flagellum[{k}]" if config.flagella else "the filament"
             raise UserInputError(
@@ -447,7 +449,7 @@ def check_walls(config) -> None:
         from flagwrap.body.multiblob import cell_body_blobs
 
         blobs, _ = cell_body_blobs(config)
-        h = float(np.min((blobs * L - p0) @ n))
+        h = float(np.min(plane.heights(blobs))) * L
         if h < 0.0:
             raise UserInputError(f"wall[0].point = {list(w.point)} m: the cell body crosses the "
                                  f"wall ({-h:.3g} m behind it): move the wall or turn its normal")
