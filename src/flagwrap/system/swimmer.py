@@ -461,15 +461,13 @@ def make_swimmer(config):
     fil = config.filament
     inner = RodSystem(config, mobility=RPYMobility(fil.bead_radius / fil.length))
     blobs, radii = cell_body_blobs(config)
-    wall = contact = None
-    if config.walls:
-        from flagwrap.hydrodynamics.wall import config_wall
+    contact = None
+    if inner.wall is not None:  # the system's plane (config_wall), seen by the body too
         from flagwrap.interactions.wall import WallContact, contact_law
 
-        wall = config_wall(config)
         cutoff, strength, c2 = contact_law(config, inner.bond)
-        contact = WallContact(wall, cutoff, strength, np.ones(len(blobs), bool), c2=c2)
-    return SwimmerSystem(inner, blobs, radii, solver=config.body.solver, wall=wall,
+        contact = WallContact(inner.wall, cutoff, strength, np.ones(len(blobs), bool), c2=c2)
+    return SwimmerSystem(inner, blobs, radii, solver=config.body.solver, wall=inner.wall,
                          wall_contact=contact)
 
 
