@@ -74,7 +74,10 @@ class Trajectory:
     n_steps: int = 0
     n_rejected: int = 0
     wall_time: float = 0.0
+    #: the state and its reference frames where the loop stopped (not stored in run files:
+    #: a continuation, e.g. a steady-state search from a run's end, starts from them)
     final_frames: object = None
+    final_y: object = None
 
     @property
     def ok(self) -> bool:
@@ -406,6 +409,7 @@ class Simulation:
                 bar.close()
             traj.wall_time = wall0 + _time.perf_counter() - start
             traj.final_frames = base
+            traj.final_y = y
         if interrupted():
             # the Ctrl-C came during the last step, or one a guard stopped: the run ended by
             # itself, but the caller asked to stop (a sweep must not go on to the next case)

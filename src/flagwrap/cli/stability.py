@@ -50,6 +50,22 @@ def add_arguments(p):
     g.add_argument("--out", default=None, metavar="FILE.json",
                    help="result file of --sweep (out/stability/<sweep name>.json)")
     g.add_argument("--workers", type=int, default=None, help="processes for --sweep (the cores)")
+    f = p.add_argument_group("two thresholds: the far (wrapped/folded) branch and its fold")
+    f.add_argument("--far", action="store_true",
+                   help="the bifurcation diagram: the whirl's Hopf, the far state's branch and its "
+                        "fold M_f, the Hopf cycle from the time domain (docs/stability.md)")
+    f.add_argument("--diagram", default=None, metavar="FILE.png",
+                   help="plot the bifurcation diagram (implies --far)")
+    f.add_argument("--far-from", default=None, metavar="RUN.nc",
+                   help="start the far branch from a run file's last frame (same helix; implies --far)")
+    f.add_argument("--m-far", type=float, default=None,
+                   help="M where the protocol is run to find a far state (1.07 M_Hopf)")
+    f.add_argument("--m-lo", type=float, default=None, help="lowest M of the far branch (0.3 M_Hopf)")
+    f.add_argument("--m-hi", type=float, default=None, help="highest M of the diagram (1.5 M_Hopf)")
+    f.add_argument("--settle", type=float, default=20.0,
+                   help="motor turns of each relaxation run on the far branch (20)")
+    f.add_argument("--cycles", default="1.02,1.05", metavar="R1,R2",
+                   help="M/M_Hopf of the time-domain Hopf cycles ('none': no cycle; 1.02,1.05)")
 
 
 def check_options(args) -> None:
@@ -70,10 +86,45 @@ def check_options(args) -> None:
         if not getattr(args, "sweep", False):
             raise UserInputError("--out is the result file of --sweep; without --sweep use --json")
         check_output_file(args.out, "--out", {".json"})
+    far = _wants_far(args)
+    if far:
+        from flagwrap.stability.bifurcation import check_diagram_options
+
+        if getattr(args, "sweep", False) or args.mode or args.vtk:
+            raise UserInputError("--far (--diagram, --far-from) draws one helix's diagram: "
+                                 "--sweep, --mode and --vtk do not apply")
+        check_diagram_options(args.m_far, args.m_lo, args.m_hi, args.settle, 1.06,
+                              _cycles(args.cycles),
+                              option=lambda name: "--" + name.replace("_", "-"))
+        if args.diagram is not None:
+            check_output_file(args.diagram, "--diagram", {".png", ".pdf", ".svg"})
+        if args.far_from is not None:
+            from pathlib import Path
+
+            if not Path(args.far_from).is_file():
+                raise UserInputError(f"--far-from: run file not found: {args.far_from}")
     if getattr(args, "sweep", False) and (args.mode or args.vtk or args.direction != "cw"
                                           or args.m_max is not None):
         raise UserInputError("--sweep computes the CW threshold of every geometry up to 30x its "
                              "scaling line: --mode, --vtk, --direction and --m-max do not apply")
+
+
+def _wants_far(args) -> bool:
+    return bool(getattr(args, "far", False) or getattr(args, "diagram", None)
+                or getattr(args, "far_from", None))
+
+
+def _cycles(text) -> tuple:
+    """``--cycles``: comma-separated M/M_Hopf ratios, or 'none'."""
+    from flagwrap.errors import UserInputError
+
+    if text is None or str(text).strip().lower() in ("none", ""):
+        return ()
+    try:
+        return tuple(float(v) for v in str(text).split(","))
+    except ValueError:
+        raise UserInputError(f"--cycles must be comma-separated numbers in (1, 2] or 'none', "
+                             f"got {text!r}") from None
 
 
 def _bar(enabled, m_start, m_max):
@@ -99,6 +150,8 @@ def run(args) -> int:
     cfg = load_config_or_case(args.config)
     if args.no_hi:
         cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
+    if _wants_far(args):
+        return _run_far(args, cfg)
     m_max = resolve_m_max(cfg, args.m_start, args.m_max)
     progress = not (args.json or args.no_progress)
     bar = _bar(progress and sys.stderr.isatty(), args.m_start, m_max)
@@ -292,3 +345,98 @@ def _row_line(row) -> str:
         return head + row["message"]
     return head + (f"M_c = {mc:8.1f} ({row['crossing']}, Omega = {row['mode_frequency']:.3f} omega), "
                    f"{row['ratio_to_scaling']:.2f}x the scaling line")
+
+
+def _torque_text(cfg, t_core) -> str:
+    """A motor torque in core units (A/L) as A/R and SI (pN nm for a bacterium)."""
+    fil = cfg.filament
+    si = t_core * fil.bending_modulus / fil.length
+    unit = f"{si * 1e21:.4g} pN nm" if fil.length < 1e-3 else f"{si:.3g} N m"
+    return f"{t_core * fil.helix_radius / fil.length:.3f} A/R = {unit}"
+
+
+def _run_far(args, cfg) -> int:
+    """``--far``: the bifurcation diagram (:func:`flagwrap.stability.bifurcation.
+    bifurcation_diagram`), printed, optionally plotted and as JSON."""
+    import json
+    import sys
+
+    from flagwrap.stability.bifurcation import FarStateNotFound, bifurcation_diagram, state_torque
+
+    progress = not (args.json or args.no_progress)
+
+    def say(line):
+        if progress:
+            print(f"  {line}", file=sys.stderr, flush=True)
+
+    if progress:
+        print(f"flagwrap stability {cfg.name} --far: the whirl's threshold, then a far state "
+              f"from the time domain followed down to its fold (about a minute for the paper's "
+              f"helix)", file=sys.stderr, flush=True)
+    try:
+        d = bifurcation_diagram(cfg, args.direction, m_far=args.m_far, m_lo=args.m_lo,
+                                m_hi=args.m_hi, settle=args.settle, cycles=_cycles(args.cycles),
+                                far_from=args.far_from, m_start=args.m_start, on_progress=say)
+    except FarStateNotFound as exc:
+        print(f"NOT FOUND: {exc}")
+        d = getattr(exc, "diagram", None)
+        if d is not None and d.hopf is not None and d.hopf.converged:
+            print(f"(the whirl: {d.hopf.crossing} at M = {d.machin_hopf:.2f}; try another "
+                  f"--m-far or --far-from a run that ended buckled)")
+        return 1
+    s = d.summary()
+    s.update(config=str(args.config), hydrodynamics=cfg.numerics.hydrodynamics,
+             machin_critical_scaling=cfg.machin_critical_scaling)
+    fil = cfg.filament
+    tq = {}
+    if d.hopf.state is not None:
+        tq["hopf"] = state_torque(d.hopf.frame, d.hopf.state)
+    fold_state = _fold_state(d)
+    if fold_state is not None:
+        tq["fold"] = state_torque(d.hopf.frame, fold_state)
+    for k, v in tq.items():
+        s[f"torque_{k}_reduced"] = v * fil.helix_radius / fil.length
+        s[f"torque_{k}"] = v * fil.bending_modulus / fil.length
+    files = []
+    if args.diagram:
+        from flagwrap.plotting.stability import plot_bifurcation
+
+        files.append(str(plot_bifurcation(d, cfg, args.diagram)))
+    s["files"] = files
+    if args.json:
+        from flagwrap.sweep.store import jsonable
+
+        print(json.dumps(jsonable(s), sort_keys=True, allow_nan=False))
+        return 0 if d.fold_found else 1
+    line = cfg.machin_critical_scaling
+    print(f"{args.config}: steady states of the {args.direction.upper()} motor in the turning "
+          f"frame (HI {'on' if cfg.numerics.hydrodynamics else 'off'}), {d.wall_time:.1f} s")
+    kind = {"hopf": "Hopf", "fold": "fold"}.get(d.hopf.crossing, "steady crossing")
+    print(f"M_Hopf  = {d.machin_hopf:.2f}  (the whirl's {kind}; {d.machin_hopf / line:.2f}x "
+          f"the paper's line {line:.0f})" + (f"; whirl torque {_torque_text(cfg, tq['hopf'])}"
+                                             if "hopf" in tq else ""))
+    print(f"far state: from {d.far_source}; {len(d.far)} states by relaxation, "
+          f"{len(d.saddle)} by arclength")
+    if d.fold_found:
+        a, b = d.fold_eigenvalues
+        print(f"M_f     = {d.machin_fold:.2f}  (the far state's fold; "
+              f"{d.machin_fold / d.machin_hopf:.3f} M_Hopf, {d.machin_fold / line:.2f}x the "
+              f"line; a real eigenvalue {a:+.3g} -> {b:+.3g} omega across it)"
+              + (f"; far-state torque {_torque_text(cfg, tq['fold'])}" if "fold" in tq else ""))
+        print(f"between M_f and M_Hopf the whirl and the far state are both stable: which one "
+              f"a run ends in depends on how hard the reversal kicks it")
+    if d.message:
+        print(f"note: {d.message}")
+    for c in d.cycles:
+        print(f"Hopf cycle at M = {c.machin:.1f} ({c.machin / d.machin_hopf:.3f} M_Hopf): "
+              f"{c.amplitude:.3f} L from the whirl, free end {c.tip_min - d.tip_z0:+.3f} .. "
+              f"{c.tip_max - d.tip_z0:+.3f} L" + (" (left for the far state)" if c.far else ""))
+    for f_ in files:
+        print(f"wrote {f_}")
+    return 0 if d.fold_found else 1
+
+
+def _fold_state(d):
+    """The far state nearest the fold (the last one above it on the stable side)."""
+    stable = [p for p in d.far if p.state is not None]
+    return min(stable, key=lambda p: p.machin).state if stable else None
