@@ -13,6 +13,12 @@ class SimulationError(RuntimeError):
     """A run that cannot continue (NaN, overlap, step size underflow); partial output is kept."""
 
 
+class ResultError(SimulationError):
+    """A computed answer came out non-finite or outside the physical range of its quantity
+    (a fit to inconsistent data, a degenerate calibration): it is not printed as an answer;
+    the CLI prints the one-line reason and exits with code 1 (the inputs passed their checks)."""
+
+
 class OutputWriteError(UserInputError):
     """A finished result could not be written where asked (disk full, folder gone); the
     message names where it was kept instead. Exit code 1 (the input was fine)."""
@@ -41,4 +47,24 @@ def check_positive(name: str, value, unit: str = "", allow_zero: bool = False) -
     if v < 0 or (v == 0 and not allow_zero):
         raise UserInputError(f"{name} must be {'>=' if allow_zero else '>'} 0"
                              f"{(' ' + unit) if unit else ''}, got {value!r}")
+    return v
+
+
+def check_range(name: str, value, lo: float, hi: float, unit: str = "") -> float:
+    """:func:`check_finite`, then ``lo <= value <= hi``; the message names ``name``, the range
+    and ``unit`` (the physical range of a quantity, so that nothing downstream overflows)."""
+    v = check_finite(name, value)
+    if not lo <= v <= hi:
+        raise UserInputError(f"{name} must be in [{lo:g}, {hi:g}]{(' ' + unit) if unit else ''}, got {value!r}")
+    return v
+
+
+def check_result(name: str, value, lo: float, hi: float, unit: str = "", hint: str = "") -> float:
+    """A computed ``value`` that must be finite and within ``[lo, hi]``, else a one-line
+    :class:`ResultError` naming it, the range and ``hint`` (what to check)."""
+    v = float(value)
+    if not (math.isfinite(v) and lo <= v <= hi):
+        u = (" " + unit) if unit else ""
+        raise ResultError(f"the result {name} = {v:.6g}{u} is not finite or outside [{lo:g}, {hi:g}]{u}"
+                          f"{': ' + hint if hint else ''}")
     return v

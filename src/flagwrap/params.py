@@ -588,6 +588,8 @@ class Joint:
     hook_bending_modulus: float | None = None
     hook_twist_modulus: float | None = None
     hook_segments: int = 0
+    #: largest hook stiffness relative to the filament's, ``A_h L / (A l_h)`` (and ``C_h``'s)
+    MAX_STIFFNESS = 1e6
 
     KINDS = ("clamp", "hook")
     MAX_SEGMENTS = 50
@@ -1052,6 +1054,21 @@ class Config:
         if self.joint.kind == "hook" and not self.joint.hook_length < fil.length:
             raise UserInputError(f"joint.hook_length = {self.joint.hook_length:g} m must be shorter "
                                  f"than the filament (filament.length = {fil.length:g} m)")
+        if self.joint.kind == "hook":
+            # a hook stiffer than ~1e6 x the filament over its length is a clamp, and its
+            # spring's time scale leaves no step the integrator can take (1e308 N m^2 ran and
+            # failed at its first step with a singular matrix)
+            for key in ("hook_bending_modulus", "hook_twist_modulus"):
+                v = getattr(self.joint, key)
+                if v is None:
+                    continue
+                k = v * fil.length / (fil.bending_modulus * self.joint.hook_length)
+                if not k <= Joint.MAX_STIFFNESS:
+                    raise UserInputError(
+                        f"joint.{key} = {v:g} N m^2 gives a hook {k:.3g} x stiffer than the filament "
+                        f"({key} L / (A hook_length)); allowed: up to {Joint.MAX_STIFFNESS:g}, i.e. "
+                        f"{key} <= {Joint.MAX_STIFFNESS * fil.bending_modulus * self.joint.hook_length / fil.length:.3g} "
+                        "N m^2 (a stiffer hook is the clamp: drop [joint])")
         if self.contact.self_contact:
             from flagwrap.interactions.self_contact import max_self_range
 

@@ -71,7 +71,9 @@ def run(args) -> int:
         if len(args.runs) != 1:
             raise UserInputError(f"--figure draws one run; got {len(args.runs)}")
         figure = check_output_file(args.figure, "--figure", suffixes=(".png", ".pdf"))
-    for path in args.runs:
+    from flagwrap.errors import UserInputError
+
+    try:  # checked once, before any file is read; the message names the option as typed
         analysis = BucklingAnalysis(
             WaitingTime(threshold=args.threshold, hold_turns=args.hold_turns,
                         smooth_turns=args.smooth_turns, onset=args.onset),
@@ -79,6 +81,16 @@ def run(args) -> int:
                        min_contact_fraction=args.min_contact_fraction,
                        contact_distance=args.contact_distance, final_turns=args.final_turns),
         )
+    except UserInputError as exc:
+        msg = str(exc)
+        for name, opt in (("min_winding_turns", "--min-winding"), ("threshold", "--threshold"),
+                          ("hold_turns", "--hold-turns"), ("smooth_turns", "--smooth-turns"),
+                          ("min_contact_fraction", "--min-contact-fraction"),
+                          ("contact_distance", "--contact-distance"), ("final_turns", "--final-turns")):
+            if msg.startswith(name + " "):
+                msg = opt + msg[len(name):]
+        raise UserInputError(msg) from None
+    for path in args.runs:
         if figure is not None:  # refused before anything is written
             from flagwrap.io.runfile import read_run
 

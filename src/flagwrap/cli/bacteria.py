@@ -30,6 +30,10 @@ def run(args: argparse.Namespace) -> int:
     from flagwrap.bacteria.species import default_species, format_table, load_species_file
     from flagwrap.errors import UserInputError
 
+    from flagwrap.errors import check_range
+
+    # c of M_c = c (R/L)^-3: the paper's 0.06; 1e308 divided by zero inside the table
+    check_range("--prefactor", args.prefactor, 1e-6, 1e3)
     species = [] if args.only_file else default_species()
     for f in args.file:
         species += load_species_file(f)

@@ -32,6 +32,14 @@ COMMANDS: dict[str, str] = {
 }
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors on one line (``flagwrap CMD: error: ...``, exit 2) instead of
+    the usage block followed by the error: every bad input is one line, whoever catches it."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def _load(name: str):
     return importlib.import_module(f"flagwrap.cli.{COMMANDS[name]}")
 
@@ -39,7 +47,7 @@ def _load(name: str):
 def build_parser() -> argparse.ArgumentParser:
     from flagwrap import __version__
 
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="flagwrap",
         description="Simulate and analyse the torque-induced buckling of a rotating elastic helix.",
     )
@@ -57,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from flagwrap.errors import OutputWriteError, UserInputError
+    from flagwrap.errors import OutputWriteError, SimulationError, UserInputError
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -77,6 +85,9 @@ def main(argv: list[str] | None = None) -> int:
     except UserInputError as exc:
         print(f"flagwrap {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except SimulationError as exc:  # a result that is not one (ResultError) or a run that stopped
+        print(f"flagwrap {args.command}: error: {exc}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

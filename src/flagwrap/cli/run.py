@@ -223,10 +223,33 @@ def _simulate(args, cfg, out, ckpt, resume) -> int:
 
     keep = out.exists() and _completed_run_at(out)
 
+    def write_or_name_checkpoint(traj, target, what):
+        # under a file-size limit or a full disk the rescue in the temporary folder fails too;
+        # the last checkpoint that was written is then where the work is kept: say so
+        from flagwrap.errors import OutputWriteError
+
+        try:
+            write_or_rescue(lambda p: write_run(traj, p), target, what)
+        except OutputWriteError as exc:
+            if ckpt is None or not ckpt.exists():
+                raise
+            msg = str(exc)
+            try:
+                from flagwrap.io.checkpoint import read_checkpoint
+
+                c = read_checkpoint(ckpt)
+                upto = f"the run up to t/T = {c.t / (2 * math.pi):.4g} ({c.n_steps} steps)"
+            except Exception:  # noqa: BLE001 - an unreadable checkpoint keeps nothing
+                raise exc from None
+            if msg.endswith("; it is lost"):
+                msg = msg[: -len("; it is lost")]
+            raise OutputWriteError(f"{msg}; {upto} is kept in the checkpoint {ckpt} "
+                                   "(--resume continues from it once there is room)") from None
+
     def write_partial(traj):
         # a failed or interrupted run never replaces a completed run file: it goes beside it
         target = out.with_name(f"{out.stem}.partial{out.suffix}") if keep else out
-        write_or_rescue(lambda p: write_run(traj, p), target, "partial run")
+        write_or_name_checkpoint(traj, target, "partial run")
         return target
 
     if resume is not None:
@@ -267,7 +290,7 @@ def _simulate(args, cfg, out, ckpt, resume) -> int:
               f"{f'; the completed {out} is unchanged' if target != out else ''})", file=sys.stderr)
         return 143 if stop.signame == "SIGTERM" else 130  # 128 + the signal's number
     if traj.ok:
-        write_or_rescue(lambda p: write_run(traj, p), out, "run file")
+        write_or_name_checkpoint(traj, out, "run file")
     else:
         out_written = write_partial(traj)
     if traj.ok and ckpt is not None and ckpt.exists():

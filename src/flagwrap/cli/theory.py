@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     # physical ranges (a molecule to a lab tank; a gel to steel), so that no value overflows
     for opt, v, lo, hi in (("--radius", args.radius, 1e-9, 10.0), ("--pitch", args.pitch, 1e-9, 10.0),
                            ("--length", args.length, 1e-9, 100.0), ("--a", args.a, 1e-10, 1.0),
-                           ("--b", args.b, 1e-10, 1.0),
+                           ("--b", args.b, 1e-10, 1.0), ("--poisson", args.poisson, -0.999, 0.5),
                            ("--youngs-modulus", args.youngs_modulus, 1.0, 1e13)):
         if not (v is not None and math.isfinite(v) and lo <= v <= hi):
             raise UserInputError(f"{opt} must be in [{lo:g}, {hi:g}] (SI), got {v!r}")

@@ -356,7 +356,27 @@ def calibrate(
         trial = replace(rig, **{n: float(v) for n, v in zip(fit, xs * scale)})
         return (project(trial, pts) - img).ravel()
 
-    sol = least_squares(resid, np.ones_like(x0), xtol=1e-15, ftol=1e-15, gtol=1e-15, x_scale="jac")
+    try:
+        project(rig, pts)
+    except UserInputError as exc:
+        raise UserInputError(f"the starting rig does not see the known points: {exc} (give distances "
+                             "near the true ones, in the known points' length unit)") from None
+    try:
+        sol = least_squares(resid, np.ones_like(x0), xtol=1e-15, ftol=1e-15, gtol=1e-15, x_scale="jac")
+    except UserInputError as exc:  # a trial rig left the physical range (a point behind a camera)
+        from flagwrap.errors import ResultError
+
+        raise ResultError(f"the calibration of {', '.join(fit)} left the physical range ({exc}): "
+                          "the known points do not fit this rig; check their coordinates and units") from None
+    # a degenerate set of known points (one point, all on the optical axes, one repeated) leaves
+    # some of the fitted parameters free: the Jacobian is rank-deficient, and the fit's values
+    # and its zero errors would be arbitrary
+    sv = np.linalg.svd(sol.jac, compute_uv=False)
+    rank = int(np.sum(sv > 1e-9 * max(float(sv[0]) if sv.size else 0.0, 1e-300)))
+    if rank < len(fit):
+        raise UserInputError(
+            f"the {pts.shape[0]} known point(s) determine only {rank} of the {len(fit)} fitted parameters "
+            f"({', '.join(fit)}): give points at different positions, off the cameras' axes")
     dof = max(img.size - len(fit), 1)
     s2 = float(sol.fun @ sol.fun) / dof
     jac = sol.jac * scale[None, :] ** -1

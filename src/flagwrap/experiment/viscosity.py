@@ -384,6 +384,11 @@ def fit_andrade(temperature: ArrayLike, viscosity: ArrayLike, viscosity_error: A
     energy = float(coef[1] / xs)
     ln_inf = float(coef[0] - energy * xm)
     err = np.sqrt(np.diag(cov))
+    if not (math.isfinite(ln_inf) and abs(ln_inf) < 700.0 and np.all(np.isfinite(err))):
+        from flagwrap.errors import ResultError
+
+        raise ResultError(f"the Andrade fit gives ln(eta_inf / Pa s) = {ln_inf:.6g}, U = {energy:.6g} J: "
+                          "not a liquid's law (the viscosities do not fall smoothly with temperature)")
     return AndradeFit(
         eta_inf=math.exp(ln_inf),
         eta_inf_error=math.exp(ln_inf) * float(err[0]),

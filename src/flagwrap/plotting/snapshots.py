@@ -54,7 +54,7 @@ def frame_indices(ds, times) -> np.ndarray:
     bad = times[~np.isfinite(times) | (times < turns[0] - tol) | (times > turns[-1] + tol)]
     if len(bad):
         raise UserInputError(
-            f"snapshot time(s) t/T = {', '.join(f'{b:g}' for b in bad)} outside the run "
+            f"snapshot time(s) (-t) t/T = {', '.join(f'{b:g}' for b in bad)} outside the run "
             f"[{turns[0]:g}, {turns[-1]:g}]"
         )
     return np.abs(turns[None, :] - times[:, None]).argmin(axis=1)
