@@ -86,16 +86,26 @@ def check_options(args) -> None:
         if not getattr(args, "sweep", False):
             raise UserInputError("--out is the result file of --sweep; without --sweep use --json")
         check_output_file(args.out, "--out", {".json"})
-    far = _wants_far(args)
-    if far:
-        from flagwrap.stability.bifurcation import check_diagram_options
+    from flagwrap.stability.bifurcation import check_diagram_options
 
+    check_diagram_options(getattr(args, "m_far", None), getattr(args, "m_lo", None),
+                          getattr(args, "m_hi", None), getattr(args, "settle", 20.0), 1.06,
+                          _cycles(getattr(args, "cycles", None)),
+                          option=lambda name: "--" + name.replace("_", "-"))
+    far = _wants_far(args)
+    if not far:
+        given = [o for o, v in (("--m-far", getattr(args, "m_far", None)),
+                                ("--m-lo", getattr(args, "m_lo", None)),
+                                ("--m-hi", getattr(args, "m_hi", None)))
+                 if v is not None]
+        if getattr(args, "settle", 20.0) != 20.0:
+            given.append("--settle")
+        if given:
+            raise UserInputError(f"{', '.join(given)}: options of the far branch; add --far")
+    if far:
         if getattr(args, "sweep", False) or args.mode or args.vtk:
             raise UserInputError("--far (--diagram, --far-from) draws one helix's diagram: "
                                  "--sweep, --mode and --vtk do not apply")
-        check_diagram_options(args.m_far, args.m_lo, args.m_hi, args.settle, 1.06,
-                              _cycles(args.cycles),
-                              option=lambda name: "--" + name.replace("_", "-"))
         if args.diagram is not None:
             check_output_file(args.diagram, "--diagram", {".png", ".pdf", ".svg"})
         if args.far_from is not None:
@@ -378,8 +388,15 @@ def _run_far(args, cfg) -> int:
                                 m_hi=args.m_hi, settle=args.settle, cycles=_cycles(args.cycles),
                                 far_from=args.far_from, m_start=args.m_start, on_progress=say)
     except FarStateNotFound as exc:
-        print(f"NOT FOUND: {exc}")
         d = getattr(exc, "diagram", None)
+        if args.json:
+            from flagwrap.sweep.store import jsonable
+
+            s = d.summary() if d is not None else {}
+            s.update(found=False, message=str(exc), config=str(args.config))
+            print(json.dumps(jsonable(s), sort_keys=True, allow_nan=False))
+            return 1
+        print(f"NOT FOUND: {exc}")
         if d is not None and d.hopf is not None and d.hopf.converged:
             print(f"(the whirl: {d.hopf.crossing} at M = {d.machin_hopf:.2f}; try another "
                   f"--m-far or --far-from a run that ended buckled)")

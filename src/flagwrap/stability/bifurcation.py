@@ -296,7 +296,7 @@ class Diagram:
                     for p in ps]
 
         return {
-            "direction": self.direction, "machin_hopf": self.machin_hopf,
+            "found": True, "direction": self.direction, "machin_hopf": self.machin_hopf,
             "hopf_crossing": self.hopf.crossing if self.hopf is not None else "",
             "machin_fold": self.machin_fold, "fold_found": self.fold_found,
             "fold_eigenvalues": list(self.fold_eigenvalues),
@@ -347,11 +347,11 @@ def read_far_from(config, path) -> dict:
     ds = read_run(path)
     try:
         rcfg = config_of(ds)
-        if not ds.sizes.get("frame", 0):
+        if not ds.sizes.get("time", 0):
             raise UserInputError(f"--far-from {path}: the run file holds no frames")
-        out = {"x": np.asarray(ds["x"].values[-1], float),
-               "theta": np.asarray(ds["theta"].values[-1], float),
-               "phi": float(ds["phi"].values[-1]), "machin": float(rcfg.machin)}
+        out = {"x": np.asarray(ds["position"].values[-1], float) / rcfg.scales.length,
+               "theta": np.asarray(ds["twist_angle"].values[-1], float),
+               "phi": float(ds["motor_angle"].values[-1]), "machin": float(rcfg.machin)}
     finally:
         ds.close()
     parts = ("filament", "body", "contact", "clamp", "joint", "flagella", "walls")
@@ -463,6 +463,16 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
                              "are not followed (only a held cell's or the rig's): set "
                              "body.motion = \"fixed\"")
     last = read_far_from(config, far_from) if far_from is not None else None
+    if last is not None and ((m_lo is not None and last["machin"] < m_lo)
+                             or (m_hi is not None and last["machin"] > m_hi)):
+        raise UserInputError(f"--far-from {far_from}: its M = {last['machin']:.5g} lies outside "
+                             f"the diagram's range [{m_lo or 0:.5g}, {m_hi or math.inf:.5g}] "
+                             f"(--m-lo, --m-hi)")
+    if config.body.no_slip:
+        raise UserInputError("flagwrap stability --far: a no-slip body's far branch is not "
+                             "followed (its blob shell cannot be stepped in the turning frame, "
+                             "where the far state is relaxed): use body.surface = \"transparent\" for the "
+                             "diagram, or --far-from a lab-frame run for the start only")
     t0 = time.perf_counter()
     say = on_progress or (lambda line: None)
     if config.motor.kind != "speed":
@@ -503,10 +513,16 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     d.whirl.sort(key=lambda p: p.machin)
 
     def whirl_near(m):
-        if not whirl_at:
+        """The whirl at ``m`` (continued afresh below the Hopf bracket), None if lost."""
+        from flagwrap.stability.steady import branch
+
+        if m in whirl_at:
+            return whirl_at[m]
+        try:
+            whirl_at[m] = branch(frame, [m], m_start=min(m_start, m / 2))[m]
+        except NewtonFailure:
             return None
-        k = min(whirl_at, key=lambda q: abs(math.log(q / m)))
-        return whirl_at[k] if abs(math.log(k / m)) < 0.06 else None
+        return whirl_at[m]
 
     # 1. a far state
     if far_from is not None:
