@@ -103,9 +103,14 @@ def check_options(args) -> None:
         if given:
             raise UserInputError(f"{', '.join(given)}: options of the far branch; add --far")
     if far:
-        if getattr(args, "sweep", False) or args.mode or args.vtk:
-            raise UserInputError("--far (--diagram, --far-from) draws one helix's diagram: "
-                                 "--sweep, --mode and --vtk do not apply")
+        if getattr(args, "sweep", False) and (args.diagram or args.far_from or args.m_far
+                                              or args.m_lo or args.m_hi):
+            raise UserInputError("--sweep --far adds each helix's fold M_f to the sweep's "
+                                 "rows: --diagram, --far-from, --m-far, --m-lo and --m-hi "
+                                 "apply to one helix")
+        if args.mode or args.vtk:
+            raise UserInputError("--far (--diagram, --far-from) draws the diagram: --mode and "
+                                 "--vtk do not apply")
         if args.diagram is not None:
             check_output_file(args.diagram, "--diagram", {".png", ".pdf", ".svg"})
         if args.far_from is not None:
@@ -307,7 +312,8 @@ def _run_sweep(args) -> int:
     from flagwrap.sweep.store import jsonable, write_json_atomic
 
     spec = load_spec(args.config)
-    out = args.out or f"out/stability/{spec.name}.json"
+    far = bool(getattr(args, "far", False))
+    out = args.out or f"out/stability/{spec.name}{'_far' if far else ''}.json"
     from flagwrap.io.outputs import check_output_file
 
     check_output_file(out, "--out", {".json"})
@@ -326,7 +332,8 @@ def _run_sweep(args) -> int:
             print(_row_line(row), flush=True)
 
     try:
-        res = stability_boundary(spec, workers=args.workers, on_row=show, rtol=args.rtol)
+        kw = {"far": True} if far else {}
+        res = stability_boundary(spec, workers=args.workers, on_row=show, rtol=args.rtol, **kw)
     finally:
         if bar is not None:
             bar.close()
@@ -353,8 +360,13 @@ def _row_line(row) -> str:
     head = f"  psi = {row['psi_deg']:5.1f} deg, n = {row['turns']:3.1f}, R/L = {row['r_over_l']:.4f}: "
     if mc is None:
         return head + row["message"]
-    return head + (f"M_c = {mc:8.1f} ({row['crossing']}, Omega = {row['mode_frequency']:.3f} omega), "
+    line = head + (f"M_c = {mc:8.1f} ({row['crossing']}, Omega = {row['mode_frequency']:.3f} omega), "
                    f"{row['ratio_to_scaling']:.2f}x the scaling line")
+    if "far_found" in row:
+        mf = row.get("machin_fold")
+        line += (f"; far state's fold M_f = {mf:.1f} ({mf / row['machin_scaling']:.2f}x)"
+                 if mf is not None else f"; no fold: {row['far_message']}")
+    return line
 
 
 def _torque_text(cfg, t_core) -> str:

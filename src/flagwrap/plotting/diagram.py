@@ -192,6 +192,9 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
 
 
 DEFAULT_STABILITY = "out/stability/fig5.json"
+#: ``flagwrap stability examples/sweeps/fig5.toml --sweep --far``: M_c and the far state's
+#: fold M_f per helix; read instead of DEFAULT_STABILITY when it exists
+DEFAULT_STABILITY_FAR = "out/stability/fig5_far.json"
 
 
 def load_stability(path):
@@ -219,6 +222,15 @@ def draw_stability(ax, stab):
         ax.scatter([r["r_over_l"] ** 3], [r["machin_c"]], marker="D", s=34, zorder=5,
                    facecolors=cmap(norm(r["psi_deg"])), edgecolors="tab:red", linewidths=1.2,
                    label="linear M_c (flagwrap stability)" if i == 0 else None)
+    folds = [r for r in stab.get("rows", []) if r.get("machin_fold")]
+    for i, r in enumerate(folds):
+        # the far (wrapped/folded) state's fold: below it every run returns to the whirl
+        ax.scatter([r["r_over_l"] ** 3], [r["machin_fold"]], marker="v", s=34, zorder=5,
+                   facecolors=cmap(norm(r["psi_deg"])), edgecolors="k", linewidths=1.0,
+                   label="far state's fold M_f (flagwrap stability --far)" if i == 0 else None)
+        if r.get("machin_c"):
+            ax.plot([r["r_over_l"] ** 3] * 2, [r["machin_fold"], r["machin_c"]], color="0.4",
+                    lw=0.8, zorder=4)
     fit = stab.get("fit") or {}
     be = fit.get("exponent")  # None (JSON's NaN) when there was nothing to fit
     if pts and be is not None and math.isfinite(be):
@@ -237,7 +249,9 @@ def fig5(outdir="out/figures", sweep_dirs=None, stability=DEFAULT_STABILITY) -> 
     ``fig5.png``, ``fig5.pdf`` and ``fig5.json`` (fit, per-geometry brackets, sources).
     If ``stability`` (out/stability/fig5.json, from ``flagwrap stability
     examples/sweeps/fig5.toml --sweep``) exists, its linear thresholds and their fit are drawn
-    beside the time-domain classes and stored in fig5.json under ``stability``.
+    beside the time-domain classes and stored in fig5.json under ``stability``; with
+    ``--far`` (out/stability/fig5_far.json, read first when it exists) also each helix's far
+    state's fold M_f, joined to its M_c: the bistable range of the helix.
     """
     import matplotlib
 
@@ -253,6 +267,8 @@ def fig5(outdir="out/figures", sweep_dirs=None, stability=DEFAULT_STABILITY) -> 
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(6.8, 6.4))
+    if stability == DEFAULT_STABILITY and Path(DEFAULT_STABILITY_FAR).is_file():
+        stability = DEFAULT_STABILITY_FAR
     stab = load_stability(stability)
     diagram(rows, ax=ax, fit=fit, brackets=brackets, stability=stab)
     n_beads = sorted({r.get("n_beads") for r in rows})

@@ -10,10 +10,11 @@ Hopf both states are stable and which one a run ends in depends on how hard it w
 
 The far branch is found and followed in three steps:
 
-1. **A far state** from the time domain: the config's motor protocol run in the turning
-   frame at ``m_far`` (by default 1.07 ``M_Hopf``, where the Fig. 4(a) helix's reversal
-   lands in the far state), plus ``settle`` more turns, then Newton from the end state
-   (:func:`far_state_from_protocol`); or a run file's last frame (:func:`far_state_from_run`).
+1. **A far state** from the time domain: the motor reversal at ``m_far`` (by default 1.07
+   ``M_Hopf``, where the Fig. 4(a) helix's reversal lands in the far state), from the steady
+   whirl of the other direction (what a long first phase of the paper's protocol ends on),
+   run ``settle`` turns in the turning frame, then Newton from the end state
+   (:func:`far_state_from_reversal`); or a run file's last frame (:func:`far_state_from_run`).
 2. **Down and up in M by relaxation** (:func:`relax`): at each new ``M`` the previous far
    state is run for ``settle`` turns in the time domain and polished by Newton. The far
    state's contact set with the body changes along the branch; the contact law's stiffness
@@ -311,17 +312,29 @@ class FarStateNotFound(RuntimeError):
     """No far state where one was looked for; the message says what the run ended in."""
 
 
-def far_state_from_protocol(config, frame, machin: float, direction: str, settle: float,
-                            whirl: SteadyState | None) -> SteadyState:
-    """The far state the config's protocol (its phases, then ``settle`` turns in
-    ``direction``) ends in at ``machin``, from the time domain in the turning frame.
-    Raises :class:`FarStateNotFound` when the end is not a fixed point, or is the whirl."""
+def far_state_from_reversal(config, frame, machin: float, direction: str, settle: float,
+                            whirl: SteadyState | None, m_start: float = 10.0) -> SteadyState:
+    """The far state the motor reversal throws the helix into at ``machin``: the steady
+    whirl of the other direction (the end of a long first phase of the paper's protocol,
+    found by Newton continuation), then ``settle`` turns in ``direction`` in the turning frame
+    and Newton from the end state. Raises :class:`FarStateNotFound` when the end is not a
+    fixed point, or is the whirl ``whirl``."""
     from flagwrap.params import Phase
+    from flagwrap.stability.steady import branch
+    from flagwrap.stability.threshold import DIRECTIONS, make_frame
 
-    protocol = tuple(config.motor.protocol) + (Phase(direction, settle),)
-    tr = _run(frame_config(config, machin, protocol))
-    what = (f"the protocol ({_protocol_text(protocol)}) at M = {machin:.5g} in the turning "
-            f"frame")
+    other = "ccw" if direction == "cw" else "cw"
+    what = (f"the reversal from the steady {other.upper()} whirl at M = {machin:.5g} "
+            f"({settle:g} {direction.upper()} turns in the turning frame)")
+    back = make_frame(config, DIRECTIONS[other])
+    try:
+        first = branch(back, [machin], m_start=min(m_start, machin / 2))[machin]
+    except NewtonFailure:
+        raise FarStateNotFound(f"no steady {other.upper()} whirl at M = {machin:.5g} to reverse "
+                               f"from (Newton continuation lost it)") from None
+    # both frames are the lab's at phi = 0: the same unknowns
+    tr = _run(frame_config(config, machin, (Phase(direction, settle),)),
+              np.concatenate([first.z, [0.0]]), first.base)
     if not tr.ok:
         raise FarStateNotFound(f"{what} stopped: {tr.message}")
     z = tr.final_y[:-1].copy()
@@ -383,12 +396,8 @@ def far_state_from_run(config, frame, path, last: dict, direction: str, settle: 
                                f"{m:.5g} does not reach a steady state ({exc})") from None
 
 
-def _protocol_text(protocol) -> str:
-    return " + ".join(f"{p.turns:g} {p.direction.upper()}" for p in protocol)
-
-
 def hopf_cycle(config, frame, whirl: SteadyState, mode: np.ndarray, direction: str,
-               turns: float = 60.0, window: float = 10.0, kick: float = 0.02) -> Cycle:
+               turns: float = 40.0, window: float = 10.0, kick: float = 0.03) -> Cycle:
     """The whirl at ``whirl.machin`` kicked by ``kick`` L along ``mode`` (a real vector over
     the unknowns, largest bead displacement 1) and run ``turns`` turns in the turning frame:
     the free end's range and the mean distance from the whirl over the last ``window``."""
@@ -447,8 +456,10 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     run file whose last frame starts it instead. The far branch is followed down to ``m_lo``
     (default 0.3 ``M_Hopf``) and up to ``m_hi`` (default 1.5 ``M_Hopf``) by steps of
     ``factor`` in ``M``, each a relaxation of ``settle`` turns; ``jump`` [L]: a relaxed state
-    farther than this from the previous one has left the branch. ``cycles``: ``M/M_Hopf`` of
-    the time-domain Hopf cycles (empty: none). ``on_progress(str)``: a line per stage.
+    farther than this from the previous one has left the branch. The steps along the branch
+    relax ``max(5, settle / 2)`` turns each (they start next to the new state). ``cycles``:
+    ``M/M_Hopf`` of the time-domain Hopf cycles (empty: none). ``on_progress(str)``: a line
+    per stage.
     Raises :class:`UserInputError` for a system the turning frame does not fit (before any
     work) and :class:`FarStateNotFound` when no far state is found (the diagram so far in
     its ``diagram`` attribute)."""
@@ -475,6 +486,8 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
                              "diagram, or --far-from a lab-frame run for the start only")
     t0 = time.perf_counter()
     say = on_progress or (lambda line: None)
+    # a step along the branch starts next to the new state: half the search's turns do
+    step_turns = max(5.0, settle / 2)
     if config.motor.kind != "speed":
         config = config.replace(motor=dataclasses.replace(
             config.motor, kind="speed", stall_torque=None, zero_load_speed=None))
@@ -531,48 +544,57 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
         d.far_source = f"the last frame of {far_from}"
     else:
         try:
-            start = far_state_from_protocol(config, frame, m_far, direction, settle,
-                                            whirl_near(m_far))
+            start = far_state_from_reversal(config, frame, m_far, direction, settle,
+                                            whirl_near(m_far), m_start)
         except FarStateNotFound as exc:
             d.wall_time = time.perf_counter() - t0
             raise _not_found(d, str(exc)) from None
-        d.far_source = (f"the protocol ({_protocol_text(config.motor.protocol)} + {settle:g} "
-                        f"{direction.upper()}) at M = {m_far:.5g}")
+        other = "CCW" if direction == "cw" else "CW"
+        d.far_source = (f"the reversal from the steady {other} whirl at M = {m_far:.5g} "
+                        f"({settle:g} {direction.upper()} turns)")
     d.far.append(arc_point(frame, start))
     say(f"far state at M = {start.machin:.5g} from {d.far_source}: free end "
         f"{start.info.x[-1, 2] - d.tip_z0:+.3f} L from rest, leading eigenvalue "
         f"{d.far[0].leading.real:+.3g} ({time.perf_counter() - t0:.1f} s)")
 
     # 2. down and up by relaxation
+    def step_to(cur, m):
+        """The stable far state at ``m`` relaxed from ``cur``, as an ArcPoint; raises
+        NewtonFailure where the relaxation left the branch (it moved by more than ``jump``,
+        or Newton polished it onto an unstable state: a short relaxation near a fold can end
+        next to the saddle)."""
+        nxt = relax(config, frame, cur.z, cur.base, m, step_turns, direction)
+        if distance(frame, nxt.z, cur.z) > jump:
+            raise NewtonFailure("jumped", nxt)
+        pt = arc_point(frame, nxt)
+        if not pt.leading.real < 0:
+            raise NewtonFailure("unstable", nxt)
+        return pt
+
     def follow(cur, step):
-        out, lost = [], None
+        out = []
         while True:
             m = cur.machin * step
             if (step < 1 and m < m_lo) or (step > 1 and m > m_hi):
                 return out, None
             try:
-                nxt = relax(config, frame, cur.z, cur.base, m, settle, direction)
-                if distance(frame, nxt.z, cur.z) > jump:
-                    raise NewtonFailure("jumped", nxt)
+                pt = step_to(cur, m)
             except NewtonFailure:
                 return out, (cur, m)
-            out.append(nxt)
-            cur = nxt
+            out.append(pt)
+            cur = pt.state
 
     down, lost = follow(start, 1.0 / factor)
-    for st in down:
-        d.far.append(arc_point(frame, st))
+    d.far += down
     if lost is not None:
         # narrow the loss to a ratio 1.003 before the arclength: fewer arc steps, same fold
         good, m_bad = lost
         while good.machin / m_bad > 1.003:
             m = math.sqrt(good.machin * m_bad)
             try:
-                nxt = relax(config, frame, good.z, good.base, m, settle, direction)
-                if distance(frame, nxt.z, good.z) > jump:
-                    raise NewtonFailure("jumped", nxt)
-                good = nxt
-                d.far.append(arc_point(frame, good))
+                pt = step_to(good, m)
+                good = pt.state
+                d.far.append(pt)
             except NewtonFailure:
                 m_bad = m
         d.far_lost_below = m_bad
@@ -601,8 +623,7 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     else:
         d.message = f"the far branch persists down to M = {m_lo:.5g} (lower --m-lo)"
     up, lost_up = follow(start, factor)
-    for st in up:
-        d.far.append(arc_point(frame, st))
+    d.far += up
     if lost_up is not None:
         note = (f"the far branch is left above M = {lost_up[0].machin:.5g} (relaxation at "
                 f"{lost_up[1]:.5g} moves away from it)")

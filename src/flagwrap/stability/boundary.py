@@ -30,20 +30,40 @@ def geometry_configs(spec) -> list:
     return out
 
 
-def helix_threshold(item, m_factor: float = 30.0, rtol: float = 1e-3) -> dict:
+def helix_threshold(item, m_factor: float = 30.0, rtol: float = 1e-3, far: bool = False) -> dict:
     """M_c of one ``(geometry, config)``: the continuation runs to ``m_factor`` x the paper's
-    scaling line. Returns a JSON-able row (never raises for a physics failure: the row says
-    what happened)."""
+    scaling line. ``far``: also the far branch's fold ``M_f``
+    (:func:`flagwrap.stability.bifurcation.bifurcation_diagram`, no Hopf cycles). Returns a
+    JSON-able row (never raises for a physics failure: the row says what happened)."""
     from threadpoolctl import threadpool_limits
 
     from flagwrap.stability.threshold import critical_from_config
 
     g, cfg = item
+    extra = {}
     with threadpool_limits(1):
         t0 = time.perf_counter()
-        r = critical_from_config(cfg, "cw", m_max=m_factor * cfg.machin_critical_scaling,
-                                 rtol=rtol)
+        if far:
+            from flagwrap.stability.bifurcation import FarStateNotFound, bifurcation_diagram
+
+            try:
+                d = bifurcation_diagram(cfg, cycles=())
+                extra = {"far_found": True, "far_message": d.message}
+            except FarStateNotFound as exc:
+                d = exc.diagram
+                extra = {"far_found": False, "far_message": str(exc)}
+            r = d.hopf
+            extra.update(machin_fold=d.machin_fold if d.fold_found else None,
+                         fold_eigenvalues=[v if math.isfinite(v) else None
+                                           for v in d.fold_eigenvalues],
+                         far_lost_below=(d.far_lost_below if math.isfinite(d.far_lost_below)
+                                         else None),
+                         far_lowest=min((p.machin for p in d.far), default=None))
+        else:
+            r = critical_from_config(cfg, "cw", m_max=m_factor * cfg.machin_critical_scaling,
+                                     rtol=rtol)
     row = dict(g)
+    row.update(extra)
     row.update(machin_c=r.machin_c if r.converged else None,
                bracket=[None if not math.isfinite(v) else v for v in r.bracket],
                crossing=r.crossing or None, converged=r.converged, message=r.message,
