@@ -6,6 +6,12 @@ runs are cached in DIR (<hash of config TOML + version>.nc/.json) and reused. Ev
 printed as it is known; the result is M_c = sqrt(M_lo M_hi) with M_hi/M_lo - 1 <= RTOL.
 The finite K biases M_c upward by ~c/K (docs/critical.md).
 
+Which question this answers: the lowest M at which the paper's rise criterion fires within K
+CW turns of the reversal. That is neither the whirl's loss of stability (`flagwrap
+stability`, the Hopf) nor the far state's existence (`flagwrap stability --far`, its fold
+M_f): near the threshold the rise can be the reversal's overshoot of a whirl it returns to.
+Whether a run *ends* buckled needs it run on (docs/stability.md, "Two thresholds").
+
 Examples::
 
     flagwrap critical examples/fig4a.toml --rtol 0.1
