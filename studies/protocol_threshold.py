@@ -23,7 +23,6 @@ import json
 import math
 import time
 
-import numpy as np
 
 
 def helix_config(name):

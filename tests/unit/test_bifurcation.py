@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import NO_SLIP_BODY, system_kinds, tiny_toml
+from conftest import system_kinds, tiny_toml
 from flagwrap.cli.main import main
 
 
@@ -160,3 +160,22 @@ def test_fig4a_far_state_at_660_and_its_fold():
     # the fold lies where the time domain loses the far state, and below the whirl's Hopf
     assert d.far_lost_below < d.machin_fold < min(p.machin for p in d.far)
     assert d.machin_fold < d.machin_hopf
+
+
+def test_sweep_far_adds_each_helix_fold(tiny, capsys):
+    spec = tiny / "swf.toml"
+    spec.write_text('name = "swf"\nmode = "grid"\n[grid]\npsi_deg = [70.0]\nturns = [2.0]\n'
+                    'machin = 100.0\n[base.filament]\nn_beads = 21\n[base.numerics]\ntol = 1e-3\n')
+    out = tiny / "swf.json"
+    code = main(["stability", str(spec), "--sweep", "--far", "--workers", "1", "--out", str(out)])
+    text = capsys.readouterr().out
+    (row,) = json.loads(out.read_text())["rows"]
+    assert code == 0, text
+    assert row["converged"] and row["far_found"]
+    assert ("far state's fold" in text) == (row["machin_fold"] is not None)
+    # where the branch ends without a smooth fold the row says so, with where it ended
+    assert row["machin_fold"] is not None or (row["far_lowest"] > row["far_lost_below"]
+                                              and "no fold" in text)
+    # --sweep --far refuses the options of one helix's diagram
+    assert main(["stability", str(spec), "--sweep", "--far", "--diagram", "x.png"]) == 2
+    assert "apply to one helix" in capsys.readouterr().err

@@ -441,7 +441,7 @@ def _run_far(args, cfg) -> int:
     print(f"{args.config}: steady states of the {args.direction.upper()} motor in the turning "
           f"frame (HI {'on' if cfg.numerics.hydrodynamics else 'off'}), {d.wall_time:.1f} s")
     kind = {"hopf": "Hopf", "fold": "fold"}.get(d.hopf.crossing, "steady crossing")
-    print(f"M_Hopf  = {d.machin_hopf:.2f}  (the whirl's {kind}; {d.machin_hopf / line:.2f}x "
+    print(f"{'M_Hopf ' if kind == 'Hopf' else 'M_c    '} = {d.machin_hopf:.2f}  (the whirl's {kind}; {d.machin_hopf / line:.2f}x "
           f"the paper's line {line:.0f})" + (f"; whirl torque {_torque_text(cfg, tq['hopf'])}"
                                              if "hopf" in tq else ""))
     print(f"far state: from {d.far_source}; {len(d.far)} states by relaxation, "
@@ -449,11 +449,11 @@ def _run_far(args, cfg) -> int:
     if d.fold_found:
         a, b = d.fold_eigenvalues
         print(f"M_f     = {d.machin_fold:.2f}  (the far state's fold; "
-              f"{d.machin_fold / d.machin_hopf:.3f} M_Hopf, {d.machin_fold / line:.2f}x the "
+              f"{d.machin_fold / d.machin_hopf:.3f} of the whirl's, {d.machin_fold / line:.2f}x the "
               f"line; a real eigenvalue {a:+.3g} -> {b:+.3g} omega across it)"
               + (f"; far-state torque {_torque_text(cfg, tq['fold'])}" if "fold" in tq else ""))
-        print(f"between M_f and M_Hopf the whirl and the far state are both stable: which one "
-              f"a run ends in depends on how hard the reversal kicks it")
+        print("between M_f and the whirl's threshold both states are stable: which one "
+              "a run ends in depends on how hard the reversal kicks it")
     if d.message:
         print(f"note: {d.message}")
     for c in d.cycles:
