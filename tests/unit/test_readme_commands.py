@@ -173,6 +173,14 @@ def test_each_headline_speed_is_stated_once():
 # slow: the same from a real wheel in a fresh virtual environment
 
 
+def _clean_env(**extra) -> dict:
+    """The environment without PYTHONPATH (which would import the checkout, not the wheel)."""
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    return {**env, **extra}
+
+
 @pytest.fixture(scope="module")
 def wheel_env(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("wheel")
@@ -182,14 +190,15 @@ def wheel_env(tmp_path_factory):
     if build.returncode != 0 or not wheels:
         pytest.skip(f"no wheel could be built here (offline?): {build.stderr.strip()[-300:]}")
     subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(tmp / "venv")],
-                   check=True)
+                   check=True, env=_clean_env())
     py = tmp / "venv" / "bin" / "python"
     subprocess.run([str(py), "-m", "pip", "install", "-q", "--no-deps", "--no-index",
-                    str(wheels[0])], check=True)
+                    str(wheels[0])], check=True, env=_clean_env())
     work = tmp / "work"  # outside the repository: no examples/, no src/
     work.mkdir()
     where = subprocess.run([str(py), "-c", "import flagwrap; print(flagwrap.__file__)"],
-                           capture_output=True, text=True, cwd=work, check=True).stdout.strip()
+                           capture_output=True, text=True, cwd=work, check=True,
+                           env=_clean_env()).stdout.strip()
     assert Path(where).is_relative_to(tmp / "venv"), f"the wheel's flagwrap is not the one imported: {where}"
     return py, tmp / "venv" / "bin" / "flagwrap", work
 
@@ -197,8 +206,7 @@ def wheel_env(tmp_path_factory):
 def _flagwrap(env, *argv, timeout=600):
     py, exe, work = env
     return subprocess.run([str(exe), *argv], capture_output=True, text=True, cwd=work,
-                          timeout=timeout, env={"PATH": str(exe.parent), "HOME": str(work),
-                                                "MPLBACKEND": "Agg"})
+                          timeout=timeout, env=_clean_env(MPLBACKEND="Agg"))
 
 
 @pytest.mark.slow
@@ -230,7 +238,8 @@ def test_readme_from_a_wheel_install(wheel_env):
             code = (f"from flagwrap.sweep.spec import load_spec; load_spec({name!r})"
                     if "--sweep" in argv else
                     f"from flagwrap.io.config import load_config_or_case; load_config_or_case({name!r})")
-            r = subprocess.run([str(py), "-c", code], capture_output=True, text=True, cwd=work)
+            r = subprocess.run([str(py), "-c", code], capture_output=True, text=True, cwd=work,
+                               env=_clean_env())
         else:
             r = _flagwrap(wheel_env, cmd, "--help")
         assert r.returncode == 0, f"{' '.join(argv)}: {r.stderr[-1000:]}"
