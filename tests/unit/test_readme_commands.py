@@ -216,9 +216,11 @@ def test_readme_from_a_wheel_install(wheel_env):
     first = cmds[0]
     assert first[:2] == ["run", "fig4a"]
     # the README's first run, in full, against the lab-frame time docs/speed.md states; the
-    # budget allows a slower machine, start-up and compiling (it is not a benchmark)
+    # budget allows a shared, loaded machine (measured: 48 s idle, 146 s with a sweep on both
+    # cores, against 28 s), start-up and compiling: it catches a run gone several times
+    # slower or a hang, it is not a benchmark
     lab, unit = speed_claims()["lab"]
-    budget = 3 * lab * (60 if unit == "min" else 1) + 180
+    budget = 6 * lab * (60 if unit == "min" else 1) + 180
     t0 = time.perf_counter()
     r = _flagwrap(wheel_env, *first, timeout=budget)
     took = time.perf_counter() - t0
@@ -243,6 +245,9 @@ def test_readme_from_a_wheel_install(wheel_env):
         else:
             r = _flagwrap(wheel_env, cmd, "--help")
         assert r.returncode == 0, f"{' '.join(argv)}: {r.stderr[-1000:]}"
+    for name in readme_figures():  # flagwrap figure fig3 | fig4 | ... [--dry-run]
+        r = _flagwrap(wheel_env, "figure", name, "--dry-run")
+        assert r.returncode == 0, f"figure {name} --dry-run: {r.stderr[-1000:]}"
     from flagwrap.cli.main import COMMANDS
 
     for name in COMMANDS:  # every command the synopsis names starts from the wheel
