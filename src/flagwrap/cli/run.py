@@ -1,4 +1,4 @@
-"""Run a simulation from a TOML config (or a built-in paper case) and write a run file.
+"""Run a simulation from a TOML config or a built-in case (by name) and write a run file.
 
 Examples::
 
