@@ -73,12 +73,32 @@ def test_synthetic_wrapped_run_file(tiny_run, tmp_path, capsys):
     assert read_run(p).attrs["analysis_state"] == "wrapping"
 
 
-def test_no_write_leaves_file_alone(tiny_run, tmp_path):
+def test_no_write_leaves_file_alone(tiny_run, tmp_path, capsys):
     p = tmp_path / "copy.nc"
     p.write_bytes(tiny_run.read_bytes())
     data = p.read_bytes()
-    assert main(["analyze", str(p), "--no-write"]) == 0
-    assert p.read_bytes() == data
+    for flag in ("--no-write", "--no-store"):
+        assert main(["analyze", str(p), flag]) == 0
+        assert p.read_bytes() == data
+        out = capsys.readouterr().out
+        assert "summary stored" not in out and f"not stored (--no-store): {p} unchanged" in out
+
+
+def test_analyze_says_it_rewrites_the_run_file(tiny_run, tmp_path, capsys):
+    # the default stores the summary in the file: the output says so, on one line, last
+    p = tmp_path / "copy.nc"
+    p.write_bytes(tiny_run.read_bytes())
+    data = p.read_bytes()
+    assert main(["analyze", str(p)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[-1].strip().startswith(f"summary stored in {p} (attributes analysis_*")
+    assert sum("summary stored" in line for line in out) == 1
+    assert p.read_bytes() != data and "analysis_state" in read_run(p).attrs
+    # --json: stdout stays one JSON object, the line goes to stderr
+    assert main(["analyze", str(p), "--json"]) == 0
+    cap = capsys.readouterr()
+    assert json.loads(cap.out)["state"] == "stable"
+    assert cap.err.startswith(f"summary stored in {p}")
 
 
 def test_bad_input_exit_2(tmp_path):

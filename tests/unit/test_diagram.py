@@ -92,3 +92,34 @@ def test_fig5_from_sweep_rows(tmp_path):
     assert info["fit"]["exponent"] == pytest.approx(3.0, rel=1e-3)
     with pytest.raises(Exception, match="no sweep results"):
         fig5(tmp_path / "fig", sweep_dirs=[tmp_path / "empty"])
+
+
+def test_fig5_names_each_star_and_puts_the_bracket_bars_in_the_legend(tmp_path):
+    # a reader must tell which star is which bacterium and what the grey bars are
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flagwrap.bacteria import default_species
+    from flagwrap.plotting.diagram import diagram, species_labels
+
+    species = default_species()
+    names = species_labels(species)
+    assert "S. putrefaciens" in names and "P. putida" in names
+    assert {"C. insecticola (coil)", "C. insecticola (normal)"} <= set(names)
+    assert len(set(names)) == len(species)
+    rows = _rows()
+    fig, ax = plt.subplots()
+    diagram(rows, ax=ax, brackets=brackets_from_rows(rows), species=species)
+    texts = {t.get_text(): t.xy for t in ax.texts}
+    for sp, name in zip(species, names):
+        assert texts[name] == (sp.radius_over_length_cubed, sp.machin)
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any(t.startswith("bracket:") for t in legend) and "bacteria (SI)" in legend
+    plt.close(fig)
+    fig, ax = plt.subplots()  # no brackets drawn: none in the legend
+    diagram(rows, ax=ax, species=[])
+    assert not any(t.get_text().startswith("bracket") for t in ax.get_legend().get_texts())
+    assert not ax.texts
+    plt.close(fig)

@@ -76,8 +76,31 @@ def test_view_limits_cover_all_frames_with_one_scale():
     short = Scene(0.0015, 0.05, 0.05, 0.4)
     frames[1, 2] = [0.0, 0.0, 0.3]
     assert view_limits(frames, short)[1][1] > 0.3
-    frames[1, 2] = [0.0, 0.0, -0.3]  # hanging below: the body is shown one radius above the cap
+    frames[1, 2] = [0.0, 0.0, -0.3]  # hanging below: the body is still shown to its top
     assert 0.1 <= view_limits(frames, short)[1][1] < 0.15
+    # a long body is never cropped at the top (a strip cut the cell off mid-cylinder)
+    long = Scene(0.0015, 0.05, 0.6, 0.4)
+    assert view_limits(frames, long)[1][1] >= 0.05 + 0.6
+
+
+def test_scale_bar_is_a_labelled_bar_in_metres_and_L():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flagwrap.plotting.render import nice_scale_bar, scale_label, style_view
+
+    assert scale_label(0.02, 0.4) == "2 cm = 0.05 L" and scale_label(1e-6, 8e-6) == "1 um = 0.125 L"
+    assert scale_label(5e-3) == "5 mm"
+    assert nice_scale_bar(0.13) == 0.02 and nice_scale_bar(0.13, fraction=0.4) == 0.05
+    fig, ax = plt.subplots()
+    style_view(ax, (-0.1, 0.1), (-0.5, 0.2), scale_bar=0.05, length=0.4)
+    bar = max(ax.lines, key=lambda l: abs(np.ptp(l.get_xdata())))
+    assert np.ptp(bar.get_xdata()) == pytest.approx(0.05) and np.ptp(bar.get_ydata()) == 0
+    assert len(ax.lines) == 3  # the bar and its two end ticks
+    assert [t.get_text() for t in ax.texts] == ["5 cm = 0.125 L"]
+    plt.close(fig)
 
 
 def test_snapshot_strip_headless(tiny_run, tmp_path):
@@ -91,6 +114,24 @@ def test_snapshot_strip_headless(tiny_run, tmp_path):
     img = iio.imread(png)
     assert img.ndim == 3 and img.shape[0] > 100
     assert (img[..., :3].std(axis=(0, 1)) > 1).all()  # not a blank image
+
+
+def test_snapshot_strip_shows_the_whole_body_and_one_scale_bar(tiny_run):
+    import matplotlib.pyplot as plt
+
+    from flagwrap.plotting.render import scene_of
+    from flagwrap.plotting.snapshots import snapshot_figure
+
+    ds = read_run(tiny_run)
+    scene = scene_of(ds)
+    fig = snapshot_figure(ds, n=3)
+    axes = np.array(fig.axes).reshape(2, 3)
+    for ax in axes.flat:  # the body's top inside every panel
+        assert ax.get_ylim()[1] >= scene.body_radius + scene.body_length
+    labelled = [(r, c) for r in range(2) for c in range(3) if axes[r, c].texts]
+    assert labelled == [(1, 0)]  # bottom left, under the strip, not between the rows
+    assert axes[1, 0].texts[0].get_text().endswith(" L")
+    plt.close(fig)
 
 
 def test_default_snapshot_times_span_the_cw_phase(tiny_run):

@@ -490,3 +490,29 @@ def test_a_damaged_row_is_named_left_out_and_computed_again(tmp_path, fake, caps
     assert (rep.skipped, rep.failed) == (1, 0)
     capsys.readouterr()
     assert len(list(store.iter_rows())) == 2 and "is damaged" not in capsys.readouterr().err
+
+
+def _write_tiny_run_file(path):
+    import numpy as np
+    import xarray as xr
+
+    from flagwrap.io.runfile import write_dataset_atomic
+
+    write_dataset_atomic(xr.Dataset({"x": ("t", np.arange(5.0))}), path)
+    return str(path)
+
+
+def test_a_run_file_is_written_inside_a_dask_worker_process(tmp_path):
+    # every case of `flagwrap sweep fig5` on a LocalCluster failed: xarray, seeing the
+    # distributed scheduler, locked the in-memory run file with a distributed Lock named after
+    # the buffer ("Semaphore or Lock `<_io.BytesIO ...>` not known"); the fake runners of the
+    # other tests write no run file, so only a real worker process shows it
+    from distributed import Client, LocalCluster
+
+    import xarray as xr
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        out = client.submit(_write_tiny_run_file, tmp_path / "r.nc").result(timeout=120)
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert list(ds["x"].values) == [0.0, 1.0, 2.0, 3.0, 4.0]

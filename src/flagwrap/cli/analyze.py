@@ -2,14 +2,15 @@
 
 Prints a summary per run file and writes the results into it (attributes ``analysis_*``,
 variables ``free_end_height``, ``winding_turns``, ``contact_fraction``, ``perversion_bead``;
-atomic rewrite) unless ``--no-write``. Criteria and defaults: docs/analysis.md. A free
-swimmer's filament is analysed in its body's frame, and its swimming is reported per motor
-phase (:mod:`flagwrap.observables.swimming`).
+the file is rewritten in place, atomically, and the output's last line per run says so)
+unless ``--no-store`` (or its older name ``--no-write``). Criteria and defaults:
+docs/analysis.md. A free swimmer's filament is analysed in its body's frame, and its swimming
+is reported per motor phase (:mod:`flagwrap.observables.swimming`).
 
 Examples::
 
     flagwrap analyze out/k600.nc
-    flagwrap analyze out/*.nc --json --no-write
+    flagwrap analyze out/*.nc --json --no-store
 """
 
 from __future__ import annotations
@@ -18,7 +19,9 @@ from __future__ import annotations
 def add_arguments(p):
     p.add_argument("runs", nargs="+", metavar="RUN.nc", help="run file(s) written by `flagwrap run`")
     p.add_argument("--json", action="store_true", help="print one JSON object per run instead of a table")
-    p.add_argument("--no-write", action="store_true", help="do not store the results in the run file")
+    p.add_argument("--no-store", "--no-write", dest="no_write", action="store_true",
+                   help="leave the run file untouched (by default the results are stored in it: "
+                        "attributes analysis_* and per-frame variables, the file rewritten in place)")
     p.add_argument("--figure", metavar="PNG", help="a free swimmer's run: draw its displacement, "
                    "motor and body rates and free-end height against time (one run only)")
     g = p.add_argument_group("criteria (defaults: docs/analysis.md)")
@@ -59,6 +62,7 @@ ROWS = [
 def run(args) -> int:
     import json
     import math
+    import sys
 
     from flagwrap.analysis.buckling import BucklingAnalysis, FinalState, WaitingTime
     from flagwrap.analysis.runfile_attrs import analyze_run_file, jsonable
@@ -104,9 +108,10 @@ def run(args) -> int:
             plot_swimming(read_run(path), figure)
         if args.json:
             print(json.dumps(jsonable(res), sort_keys=True))
+            if not args.no_write:  # stdout stays one JSON object per run
+                print(stored_line(path), file=sys.stderr)
             continue
-        print(f"{path} (run status: {res['run_status']})"
-              + ("" if args.no_write else "  [results stored in file]"))
+        print(f"{path} (run status: {res['run_status']})")
         for key, label, fmt in ROWS:
             v = res[key]
             print(f"  {label:<30s} {fmt.format(v) if not (isinstance(v, float) and v != v) else '-'}")
@@ -144,4 +149,13 @@ def run(args) -> int:
                   f"speed {ph['speed'] * 1e6:+.4g} um/s (+ body first), body rotation "
                   f"{ph['body_rotation_hz']:+.4g} Hz, motor {ph['motor_rate_hz']:+.4g} Hz, "
                   f"{ph['displacement_per_turn'] * 1e9:+.4g} nm per motor turn")
+        print(f"  not stored (--no-store): {path} unchanged" if args.no_write
+              else f"  {stored_line(path)}")
     return 0
+
+
+def stored_line(path) -> str:
+    """The one line that says the run file was rewritten."""
+    return (f"summary stored in {path} (attributes analysis_*, variables free_end_height, "
+            "winding_turns, contact_fraction, perversion_bead; rewritten in place, --no-store "
+            "leaves it untouched)")

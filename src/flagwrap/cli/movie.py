@@ -62,6 +62,9 @@ def run(args) -> int:
         if bar is not None:
             bar.update(1)
 
+    import time
+
+    start = time.perf_counter()
     try:
         path = write_movie(ds, out, fps=args.fps, speed=speed, size=size, progress=progress)
     finally:
@@ -69,5 +72,7 @@ def run(args) -> int:
             bar.close()
     if path.suffix != out.suffix:
         print(f"ffmpeg unavailable: wrote a GIF instead of {out.suffix}")
-    print(f"{path}: {n} frames of {size[0]}x{size[1]} at {args.fps:g} fps")
+    took = time.perf_counter() - start
+    print(f"{path}: {n} frames of {size[0]}x{size[1]} at {args.fps:g} fps, rendered and encoded "
+          f"in {took:.1f} s ({took / max(n, 1):.3f} s per frame)")
     return 0

@@ -1,10 +1,14 @@
-"""Run a simulation from a TOML config (or a built-in paper case) and write a run file.
+"""Run a simulation from a TOML config or a built-in case (by name) and write a run file.
 
 Examples::
 
     flagwrap run examples/fig4a.toml -o out/fig4a.nc
-    flagwrap run --case fig4a -o out/fig4a.nc --figure out/fig4a.png
+    flagwrap run fig4a -o out/fig4a.nc --figure out/fig4a.png     # a built-in case, from any folder
+    flagwrap run --list-cases                                     # the built-in cases (examples/*.toml)
     flagwrap run examples/fig4a.toml -o out/fig4a.nc --resume     # after a crash or kill
+
+Built-in cases: every example config ships with the package; its name (``fig4a``, ``hook``,
+``s_putrefaciens``, ...) works wherever a config path does (run, critical, stability, the API).
 
 Checkpoints: the complete loop state goes to ``--checkpoint`` (default ``<output>.ckpt.h5``)
 every ``--checkpoint-seconds`` (default 60) of wall time and/or every ``--checkpoint-every``
@@ -28,11 +32,15 @@ import sys
 PRECISE_TOL = 1e-6
 
 def add_arguments(p):
-    p.add_argument("config", nargs="?", help="TOML config file (see examples/)")
+    p.add_argument("config", nargs="?",
+                   help="TOML config file or the name of a built-in case (--list-cases)")
     from flagwrap.cases import CASES
 
-    p.add_argument("--case", choices=sorted(CASES),
-                   help="built-in paper case instead of a file: " + ", ".join(sorted(CASES)))
+    p.add_argument("--case", choices=sorted(CASES), metavar="NAME",
+                   help="a built-in case instead of a file (same as giving its name as CONFIG)")
+    p.add_argument("--list-cases", action="store_true",
+                   help="list the built-in cases (the example configs shipped with the package) "
+                        "and where their files are, and run nothing")
     p.add_argument("-o", "--output", help="run file to write (.nc); default out/<name>.nc")
     p.add_argument("--figure", help="also write a summary figure (PNG/PDF) of tip height and torque")
     p.add_argument("--no-hi", action="store_true", help="switch long-range hydrodynamics off")
@@ -129,6 +137,8 @@ def run(args) -> int:
     from flagwrap.errors import UserInputError
     from flagwrap.resources import check_disk, check_memory
 
+    if getattr(args, "list_cases", False):
+        return _list_cases(args)
     cfg = load(args)
     out = Path(args.output or f"out/{cfg.name}.nc")
     if args.checkpoint_every < 0:
@@ -161,6 +171,22 @@ def run(args) -> int:
         check_output_file(args.figure, "--figure", suffixes=figure_suffixes())
     with output_lock(out, ckpt):
         return _simulate(args, cfg, out, ckpt, resume)
+
+
+def _list_cases(args) -> int:
+    """Print each built-in case: name, what it is (its file's first comment line), and the
+    folder of the files (to copy one and edit it)."""
+    from flagwrap.cases import CASES_DIR, case_files, describe
+    from flagwrap.errors import UserInputError
+
+    if args.config is not None or args.case is not None:
+        raise UserInputError("--list-cases takes no config or --case")
+    names = case_files()
+    width = max(map(len, names))
+    for name in names:
+        print(f"{name:<{width}}  {describe(name)}")
+    print(f"({len(names)} cases; files in {CASES_DIR}; run one by name: flagwrap run NAME)")
+    return 0
 
 
 def _dry_run(cfg, est, out) -> int:

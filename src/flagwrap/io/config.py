@@ -243,8 +243,12 @@ def load_config_or_case(name) -> Config:
     path = Path(name)
     if path.is_file() or str(name) not in CASES:
         if not path.is_file():
+            if path.suffix == ".toml" and path.stem in CASES:  # examples/hook.toml outside a checkout
+                raise UserInputError(f"config file not found: {path}; the built-in case "
+                                     f"{path.stem!r} is the shipped copy of examples/{path.name}: "
+                                     f"give {path.stem} instead")
             raise UserInputError(f"config file not found: {path} (a built-in case instead: "
-                                 f"{', '.join(sorted(CASES))})")
+                                 f"{', '.join(sorted(CASES))}; `flagwrap run --list-cases`)")
         return load_config(path)
     return get_case(str(name))
 

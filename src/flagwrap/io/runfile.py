@@ -168,11 +168,20 @@ def trajectory_dataset(traj):
 
 def write_dataset_atomic(ds, path) -> Path:
     """Write an xarray dataset to ``path`` atomically (see :mod:`flagwrap.io.atomic`)."""
+    import dask
+
     from flagwrap.io.atomic import write_image
 
-    return write_image(path, lambda target: ds.to_netcdf(target, engine="h5netcdf",
-                                                         encoding=checksummed(ds)),
-                       size_hint=int(ds.nbytes))
+    def build(target):
+        # xarray takes a write lock of the scheduler it sees; in a Dask worker process (a
+        # sweep on a LocalCluster) that is a distributed Lock named after the in-memory
+        # target, which the scheduler does not know, and every write failed ("Semaphore or
+        # Lock `<_io.BytesIO ...>` not known"). One process writes one buffer here: a local
+        # lock is the right one (another writer of the path is kept off by output_lock)
+        with dask.config.set(scheduler="synchronous"):
+            ds.to_netcdf(target, engine="h5netcdf", encoding=checksummed(ds))
+
+    return write_image(path, build, size_hint=int(ds.nbytes))
 
 
 def checksummed(ds) -> dict:

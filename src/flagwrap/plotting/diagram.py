@@ -151,17 +151,27 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
         from flagwrap.bacteria import default_species
 
         species = default_species()
+    names = species_labels(species)
     for i, sp in enumerate(species):
         ax.scatter([sp.radius_over_length_cubed], [sp.machin], marker="*", s=140, c="tab:red",
                    edgecolors="k", linewidths=0.5, zorder=4, label="bacteria (SI)" if i == 0 else None)
         xs = np.append(xs, sp.radius_over_length_cubed)
+    mid = 0.5 * (np.log10(xs.min()) + np.log10(xs.max()))
+    for name, sp in zip(names, species):  # named beside the star, towards the middle
+        right = np.log10(sp.radius_over_length_cubed) > mid
+        ax.annotate(name, (sp.radius_over_length_cubed, sp.machin),
+                    xytext=(-7 if right else 7, -3), ha="right" if right else "left",
+                    textcoords="offset points", fontsize=7, color="darkred", style="italic",
+                    zorder=6, bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75))
     xline = np.logspace(np.log10(xs.min()) - 0.15, np.log10(xs.max()) + 0.15, 50)
     ax.plot(xline, PAPER_PREFACTOR / xline, "k-", lw=1.5, label=r"paper: $M_c = 0.06\,(R/L)^{-3}$")
     if brackets:
+        first = True
         for b in brackets:
             if b.get("kind") == "bracket":
                 ax.plot([b["r_over_l_cubed"]] * 2, [b["m_lo"], b["m_hi"]], "k-", lw=3, alpha=0.35,
-                        zorder=2)
+                        zorder=2, label="bracket: last stable to first buckled M" if first else None)
+                first = False
     if fit is not None:
         if math.isfinite(fit.get("exponent", math.nan)):
             c, be = fit["prefactor"], fit["exponent"]
@@ -189,6 +199,16 @@ def diagram(rows, ax=None, species=None, fit=None, brackets=None, psi_range=(30.
     handles = [proxy.get(lab, h) for h, lab in zip(handles, labels)]
     ax.legend(handles, labels, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3)
     return ax
+
+
+def species_labels(species) -> list[str]:
+    """Short names for the stars: genus initial and species ("S. putrefaciens"), the filament
+    form added where one species has two ("C. insecticola (coil)")."""
+    short = []
+    for sp in species:
+        words = sp.name.split()
+        short.append(f"{words[0][0]}. {words[1]}" if len(words) >= 2 else sp.name)
+    return [f"{n} ({sp.form})" if short.count(n) > 1 else n for n, sp in zip(short, species)]
 
 
 DEFAULT_STABILITY = "out/stability/fig5.json"

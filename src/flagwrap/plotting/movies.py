@@ -157,7 +157,8 @@ class MovieFrames:
         self.ax_views = [fig.add_axes((0.01, 0.02, 0.31, 0.88)), fig.add_axes((0.33, 0.02, 0.31, 0.88))]
         bar = nice_scale_bar(self.ulim[1] - self.ulim[0])
         for k, (ax, cam) in enumerate(zip(self.ax_views, CAMERAS)):
-            style_view(ax, self.ulim, self.zlim, title=cam.name, scale_bar=bar if k == 0 else None)
+            style_view(ax, self.ulim, self.zlim, title=cam.name, scale_bar=bar if k == 0 else None,
+                       length=self.scene.length)
         turns = ds["turns"].values
         L = ds.attrs["length"]
         from flagwrap.io.runfile import filament_slices

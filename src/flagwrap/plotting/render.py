@@ -393,9 +393,9 @@ def view_limits(frames: np.ndarray, scene: Scene, cameras=CAMERAS, margin: float
     Returns
     -------
     (u_min, u_max), (z_min, z_max) : horizontal and vertical limits [m], the horizontal range
-    centred on the body axis and wide enough for all cameras. The body is shown down from its
-    top only as far as the filament climbs (at least one body radius above the cap). A moving
-    body (``poses``, :func:`body_poses` of the frames shown) is kept in view whole.
+    centred on the body axis and wide enough for all cameras. The body is shown whole, up to
+    its top (a cell cut off at the frame's edge read as a cropped figure). A moving body
+    (``poses``, :func:`body_poses` of the frames shown) is kept in view whole as well.
     """
     frames = np.asarray(frames, float)
     if poses is not None:
@@ -408,16 +408,17 @@ def view_limits(frames: np.ndarray, scene: Scene, cameras=CAMERAS, margin: float
     zmin = float(frames[..., 2].min()) - a
     zmax = float(frames[..., 2].max()) + a
     if scene.has_body and poses is None:
-        # the body is shown up to where the filament climbs, at least one radius above the
-        # cap, never past its top; the filament itself is never cut
-        body_top = min(max(zmax, 2.0 * scene.body_radius), scene.body_radius + scene.body_length)
-        zmax = max(zmax, body_top)
+        # the whole body, to its top; the filament itself is never cut
+        zmax = max(zmax, scene.body_radius + scene.body_length)
     m = margin * scene.length
     return (-half - m, half + m), (zmin - m, zmax + m)
 
 
-def style_view(ax, ulim, zlim, title: str | None = None, scale_bar: float | None = None):
-    """Equal-aspect, frameless axes with optional title and a scale bar of ``scale_bar`` [m]."""
+def style_view(ax, ulim, zlim, title: str | None = None, scale_bar: float | None = None,
+               length: float | None = None):
+    """Equal-aspect, frameless axes with optional title and a scale bar of ``scale_bar`` [m]
+    at the bottom left: a bar with end ticks, labelled with its length (um, mm or cm) and, if
+    the filament's ``length`` [m] is given, as a fraction of ``L``."""
     ax.set_xlim(*ulim)
     ax.set_ylim(*zlim)
     ax.set_aspect("equal", adjustable="box")
@@ -428,18 +429,30 @@ def style_view(ax, ulim, zlim, title: str | None = None, scale_bar: float | None
     if title:
         ax.set_title(title, fontsize=8)
     if scale_bar:
-        x0 = ulim[0] + 0.05 * (ulim[1] - ulim[0])
-        y0 = zlim[0] + 0.03 * (zlim[1] - zlim[0])
-        ax.plot([x0, x0 + scale_bar], [y0, y0], color="k", lw=1.5, solid_capstyle="butt")
-        label = (f"{scale_bar * 100:g} cm" if scale_bar >= 0.01 else
-                 f"{scale_bar * 1e3:g} mm" if scale_bar >= 1e-3 else f"{scale_bar * 1e6:g} um")
-        ax.text(x0 + scale_bar / 2, y0 + 0.01 * (zlim[1] - zlim[0]), label, ha="center",
-                va="bottom", fontsize=6)
+        du, dz = ulim[1] - ulim[0], zlim[1] - zlim[0]
+        x0, y0 = ulim[0] + 0.04 * du, zlim[0] + 0.03 * dz
+        tick = 0.012 * dz
+        ax.plot([x0, x0 + scale_bar], [y0, y0], color="k", lw=2.0, solid_capstyle="butt",
+                zorder=10)
+        for x in (x0, x0 + scale_bar):
+            ax.plot([x, x], [y0 - tick, y0 + tick], color="k", lw=1.0, zorder=10)
+        ax.text(x0, y0 + 1.6 * tick, scale_label(scale_bar, length), ha="left", va="bottom",
+                fontsize=6, zorder=10)
 
 
-def nice_scale_bar(span: float) -> float:
-    """A round length [m] of about a fifth of ``span`` [m] (1, 2 or 5 times a power of ten)."""
-    target = span / 5
+def scale_label(bar: float, length: float | None = None) -> str:
+    """``"2 cm"`` for a bar of 0.02 m; ``"2 cm = 0.05 L"`` with the filament's length."""
+    label = (f"{bar * 100:g} cm" if bar >= 0.01 else
+             f"{bar * 1e3:g} mm" if bar >= 1e-3 else f"{bar * 1e6:g} um")
+    if length:
+        label += f" = {bar / length:.3g} L"
+    return label
+
+
+def nice_scale_bar(span: float, fraction: float = 0.2) -> float:
+    """A round length [m] of at most ``fraction`` of ``span`` [m] (1, 2 or 5 times a power of
+    ten)."""
+    target = span * fraction
     p = 10 ** np.floor(np.log10(target))
     for k in (5, 2, 1):
         if k * p <= target:

@@ -104,7 +104,7 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     fig, axes = plt.subplots(2, ncol, figsize=(panel_width * ncol + 0.4, 2 * panel_width * aspect + 0.8),
                              squeeze=False)
     rend = Renderer(scene, **(renderer_kwargs or {}))
-    bar = nice_scale_bar(ulim[1] - ulim[0])
+    bar = nice_scale_bar(ulim[1] - ulim[0], fraction=0.4)  # a bar one can read at strip size
     for j, i in enumerate(idx):
         for r, cam in enumerate(CAMERAS):
             ax = axes[r, j]
@@ -112,7 +112,8 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
             sense = "CW" if om[i] < 0 else ("CCW" if om[i] > 0 else "stop")
             style_view(ax, ulim, zlim,
                        title=f"$t/T$ = {turns[i]:.2f} ({sense})" if r == 0 else None,
-                       scale_bar=bar if (j == 0 and r == 0) else None)
+                       scale_bar=bar if (j == 0 and r == len(CAMERAS) - 1) else None,
+                       length=scene.length)
         axes[0, j].set_title(axes[0, j].get_title(), fontsize=7)
     for r, cam in enumerate(CAMERAS):
         axes[r, 0].set_ylabel(cam.name, fontsize=7)
