@@ -142,6 +142,31 @@ def test_every_kind_is_followed_or_refused_by_name(tiny, capsys, kind):
     assert s["machin_hopf"] > 0 and s["far"]
 
 
+@pytest.mark.parametrize("extra", [
+    # the lumped hook of examples/hook.toml scaled to this helix (k_h = 0.6)
+    "[joint]\nkind = 'hook'\nhook_length = 0.004\nhook_bending_modulus = 3.58e-8\n",
+    "",  # buoyancy: the filament 0.5 % heavier than the fluid (below)
+], ids=["hook", "buoyancy"])
+def test_hook_and_buoyancy_are_accepted_and_answered(tiny, capsys, extra):
+    # the kinds the diagram takes besides the clamp: it runs and answers with what it found
+    # (for this coarse helix neither has a far state at rest after the reversal: exit 1 with
+    # the whirl's threshold and the reason), never a refusal or a traceback
+    text = tiny_toml() + extra
+    if not extra:
+        text = text.replace("n_beads = 21", "n_beads = 21\ndensity_mismatch = 0.005")
+    path = tiny / f"kind_{'hook' if extra else 'buoyant'}.toml"
+    path.write_text(text)
+    code = main(["stability", str(path), "--far", "--json", "--cycles", "none", "--settle", "10"])
+    out, err = capsys.readouterr()
+    s = json.loads(out)
+    assert code in (0, 1), err
+    assert s["machin_hopf"] > 0 and s["hopf_crossing"] in ("hopf", "fold")
+    if s["found"]:
+        assert s["far"] and all(p["leading_re"] < 0 for p in s["far"])
+    else:
+        assert "does not end at rest" in s["message"] or "ends on the whirl" in s["message"]
+
+
 @pytest.mark.slow
 def test_fig4a_far_state_at_660_and_its_fold():
     """Acceptance: the Fig. 4(a) far state at M = 660 is a fixed point of the turning-frame
