@@ -59,7 +59,7 @@ def add_arguments(p):
     f.add_argument("--far-from", default=None, metavar="RUN.nc",
                    help="start the far branch from a run file's last frame (same helix; implies --far)")
     f.add_argument("--m-far", type=float, default=None,
-                   help="M where the protocol is run to find a far state (1.07 M_Hopf)")
+                   help="M of the reversal that finds a far state (1.07, then 1.25, 1.5 M_Hopf)")
     f.add_argument("--m-lo", type=float, default=None, help="lowest M of the far branch (0.3 M_Hopf)")
     f.add_argument("--m-hi", type=float, default=None, help="highest M of the diagram (1.5 M_Hopf)")
     f.add_argument("--settle", type=float, default=20.0,

@@ -308,6 +308,10 @@ class Diagram:
         }
 
 
+#: M / M_c at which the reversal is tried in turn when no ``m_far`` is given
+FAR_LADDER = (1.07, 1.25, 1.5)
+
+
 class FarStateNotFound(RuntimeError):
     """No far state where one was looked for; the message says what the run ended in."""
 
@@ -452,7 +456,8 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
                         on_progress=None) -> Diagram:
     """The whirl (Hopf), the far branch (fold) and the Hopf cycle of ``config``'s helix.
 
-    ``m_far``: where the far state is looked for (default 1.07 ``M_Hopf``); ``far_from``: a
+    ``m_far``: where the far state is looked for (default: 1.07, 1.25 and 1.5 ``M_Hopf`` in
+    turn, :data:`FAR_LADDER`, until one reversal ends at rest away from the whirl); ``far_from``: a
     run file whose last frame starts it instead. The far branch is followed down to ``m_lo``
     (default 0.3 ``M_Hopf``) and up to ``m_hi`` (default 1.5 ``M_Hopf``) by steps of
     ``factor`` in ``M``, each a relaxation of ``settle`` turns; ``jump`` [L]: a relaxed state
@@ -503,9 +508,14 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     mc = hopf.machin_c
     say(f"whirl: {hopf.crossing} at M = {mc:.5g} ({len(hopf.branch)} states, "
         f"{time.perf_counter() - t0:.1f} s)")
-    m_far = 1.07 * mc if m_far is None else float(m_far)
     m_lo = 0.3 * mc if m_lo is None else float(m_lo)
     m_hi = 1.5 * mc if m_hi is None else float(m_hi)
+    # where the reversal is tried: the given M, or a ladder above the threshold (just above
+    # it a slowly growing whirl, e.g. a Hopf at Omega ~ omega, may not leave within the
+    # turns; higher up the kick is harder), within the diagram
+    ladder = ([float(m_far)] if m_far is not None else
+              [r * mc for r in FAR_LADDER if r * mc <= m_hi] or [m_hi])
+    m_far = ladder[0]
     if not m_lo < m_far <= m_hi:
         raise UserInputError(f"the far state's M ({m_far:.5g}) must lie in the diagram's range "
                              f"({m_lo:.5g}, {m_hi:.5g}]")
@@ -543,12 +553,18 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
                                    (m_lo, m_hi))
         d.far_source = f"the last frame of {far_from}"
     else:
-        try:
-            start = far_state_from_reversal(config, frame, m_far, direction, settle,
-                                            whirl_near(m_far), m_start)
-        except FarStateNotFound as exc:
+        tried = []
+        for m_far in ladder:
+            try:
+                start = far_state_from_reversal(config, frame, m_far, direction, settle,
+                                                whirl_near(m_far), m_start)
+                break
+            except FarStateNotFound as exc:
+                tried.append(str(exc))
+                say(f"no far state: {exc}")
+        else:
             d.wall_time = time.perf_counter() - t0
-            raise _not_found(d, str(exc)) from None
+            raise _not_found(d, "; ".join(tried)) from None
         other = "CCW" if direction == "cw" else "CW"
         d.far_source = (f"the reversal from the steady {other} whirl at M = {m_far:.5g} "
                         f"({settle:g} {direction.upper()} turns)")
