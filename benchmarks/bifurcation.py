@@ -3,7 +3,7 @@
 Run: ``python benchmarks/bifurcation.py [--case fig4a] [--cycles 1.02,1.05]``
 
 Measured in one process, on one core (BLAS limited to one thread), after a tiny diagram has
-compiled and loaded the kernels: the whole diagram of the case's helix (the whirl and its
+compiled and loaded the kernels (a short whirl branch and run): the whole diagram of the case's helix (the whirl and its
 Hopf, a far state from the reversal, the far branch down to its fold and up to 1.5 M_Hopf,
 the Hopf cycles of ``--cycles``), with the time at which each stage ended. Prints M_Hopf,
 M_f and the seconds; ``ratio`` = the whole diagram's seconds / 60 (the target: under a minute
@@ -31,12 +31,16 @@ def main(argv=None) -> int:
     with threadpool_limits(1):
         import dataclasses
 
+        from flagwrap.params import Phase
+        from flagwrap.simulation import Simulation, make_system
+        from flagwrap.stability.threshold import critical_from_config
+
+        # compile and load the kernels: a short whirl branch and a short turning-frame run
         warm = get_case(args.case)
-        warm = warm.replace(filament=dataclasses.replace(warm.filament, n_beads=21))
-        try:  # compile and load the kernels (a coarse helix: its numbers are not reported)
-            bifurcation_diagram(warm, cycles=(), m_lo=None)
-        except Exception:  # noqa: BLE001 - only the warm-up
-            pass
+        critical_from_config(warm, "cw", m_max=60.0)
+        warm = warm.replace(motor=dataclasses.replace(warm.motor, protocol=(Phase("cw", 0.2),)),
+                            numerics=dataclasses.replace(warm.numerics, frame="rotating"))
+        Simulation(warm, system=make_system(warm)).run()
         t0 = time.perf_counter()
         stages = []
         d = bifurcation_diagram(get_case(args.case), cycles=cycles,

@@ -162,7 +162,7 @@ def test_each_headline_speed_is_stated_once():
     assert {"lab", "turning", "stability-sweep", "movie-frame", "tests"} <= set(claims)
     assert "docs/speed.md" in README.read_text(encoding="utf-8")
     pages = [README, *sorted((ROOT / "docs").glob("*.md"))]
-    for key in ("lab", "turning", "stability-sweep", "movie-frame"):
+    for key in ("lab", "turning", "stability-sweep", "movie-frame", "bifurcation"):
         value, unit = claims[key]
         needle = re.compile(rf"(?<![\d.]){re.escape(f'{value:g}')} {unit}\b")
         where = [p.name for p in pages if p != SPEED and needle.search(p.read_text(encoding="utf-8"))]

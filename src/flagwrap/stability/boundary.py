@@ -53,7 +53,17 @@ def helix_threshold(item, m_factor: float = 30.0, rtol: float = 1e-3, far: bool 
                 d = exc.diagram
                 extra = {"far_found": False, "far_message": str(exc)}
             r = d.hopf
-            extra.update(machin_fold=d.machin_fold if d.fold_found else None,
+            from flagwrap.stability.bifurcation import state_torque
+
+            fil = cfg.filament
+            reduced = fil.helix_radius / fil.length  # A/L -> A/R
+            lowest = min(d.far, key=lambda p: p.machin, default=None)
+            extra.update(
+                torque_c_reduced=(state_torque(r.frame, r.state) * reduced
+                                  if r.state is not None else None),
+                torque_fold_reduced=(state_torque(r.frame, lowest.state) * reduced
+                                     if d.fold_found and lowest is not None else None),
+                machin_fold=d.machin_fold if d.fold_found else None,
                          fold_eigenvalues=[v if math.isfinite(v) else None
                                            for v in d.fold_eigenvalues],
                          far_lost_below=(d.far_lost_below if math.isfinite(d.far_lost_below)
