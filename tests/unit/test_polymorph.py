@@ -268,3 +268,111 @@ def test_helix_curvature_torsion_of_a_known_helix():
     assert pm.helix_curvature_torsion(1.0, 2 * math.pi, "left") == pytest.approx((0.5, -0.5))
     with pytest.raises(UserInputError, match="handedness"):
         pm.helix_curvature_torsion(1.0, 1.0, "up")
+
+
+# --- the polymorph library -------------------------------------------------------------
+try:  # noqa: E402
+    import tomllib
+except ImportError:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+from flagwrap.elasticity import polymorph_library as pl  # noqa: E402
+
+
+def _packaged_doc():
+    from importlib import resources
+    return tomllib.loads(resources.files("flagwrap").joinpath("data/polymorphs.toml")
+                         .read_text(encoding="utf-8"))
+
+
+def test_packaged_library_loads_with_a_source_for_every_number():
+    lib = pl.default_library()
+    normal = lib.polymorph("ecoli_normal")
+    assert (normal.radius_um.value, normal.pitch_um.value, normal.handedness.value) == (0.2, 2.3, "left")
+    semi = lib.polymorph("ecoli_semicoiled")
+    assert semi.handedness.value == "right" and semi.pitch_um.value == pytest.approx(2.3 / 2)
+    t = lib.transition("salmonella_normal_semicoiled")
+    assert (t.torque_forward_pn_um.value, t.torque_back_pn_um.value) == (-1.1, 0.4)
+    assert "Hotani" in t.torque_forward_pn_um.source and t.wall_width_um.value is None
+    assert lib.bending_stiffness_pn_um2.value == 3.5
+    for p in lib.polymorphs:
+        for f in (p.radius_um, p.pitch_um, p.handedness):
+            assert f.source.strip() and (f.value is None) == (f.status == "gap")
+    # the gaps are flagged, and refuse to be used silently
+    coiled = lib.polymorph("ecoli_coiled")
+    assert not coiled.known
+    with pytest.raises(UserInputError, match="ecoli_coiled.*radius_um is a gap"):
+        coiled.curvature_torsion_per_um()
+    k, tau = normal.curvature_torsion_per_um()
+    assert tau < 0 < k  # left-handed
+
+
+def test_hotani_loop_gives_a_model_with_the_stated_thresholds():
+    """Hotani's two torques as the model's spinodals (P6), with the E. coli normal and
+    semicoiled torsions as Delta (a cross-organism stand-in, flagged in the docs)."""
+    lib = pl.default_library()
+    t = lib.transition("salmonella_normal_semicoiled")
+    _, tau_a = lib.polymorph("ecoli_normal").curvature_torsion_per_um()
+    _, tau_b = lib.polymorph("ecoli_semicoiled").curvature_torsion_per_um()
+    # forward (A -> B) needs the negative torque, so Delta < 0 as the model requires
+    model = pm.PolymorphModel.from_thresholds(t.torque_forward_pn_um.value,
+                                              t.torque_back_pn_um.value, tau_a - tau_b,
+                                              wall_width=0.5)
+    assert model.switch_torques == pytest.approx((-1.1, 0.4))
+    assert model.maxwell_torque == pytest.approx(-0.35)
+
+
+def _edited(path, value, doc=None):
+    doc = doc or _packaged_doc()
+    node = doc
+    for k in path[:-1]:
+        node = node[k]
+    if value is None:
+        del node[path[-1]]
+    else:
+        node[path[-1]] = value
+    return doc
+
+
+@pytest.mark.parametrize("path,value,message", [
+    (("transition", 0, "to"), "salmonella_curly",
+     r"^<toml>: transition 'salmonella_normal_semicoiled': to = 'salmonella_curly' is not a "
+     r"polymorph of the library; allowed: ecoli_normal, "),
+    (("polymorph", 0, "radius_um"), None,
+     r"^<toml>: polymorph 'ecoli_normal': radius_um is missing; give a value in \(0, 1e\+06\) um"),
+    (("polymorph", 1, "pitch_um"), None, r"^<toml>: polymorph 'ecoli_semicoiled': pitch_um is missing"),
+    (("transition", 0, "torque_forward_pn_um", "value"), 1.1,
+     r"^<toml>: transition 'salmonella_normal_semicoiled': torque_forward_pn_um must be in "
+     r"\(-1e\+06, 0\) pN um \(negative"),
+    (("transition", 0, "torque_back_pn_um", "value"), -0.4,
+     r"torque_back_pn_um must be in \(0, 1e\+06\) pN um \(positive"),
+    (("polymorph", 0, "pitch_um", "source"), None, r"ecoli_normal': pitch_um needs a non-empty 'source'"),
+    (("polymorph", 0, "handedness", "value"), "up", r"handedness must be 'left' or 'right'"),
+    (("polymorph", 3, "radius_um", "value"), 0.3, r"ecoli_coiled': radius_um has status 'gap' but a value"),
+])
+def test_bad_library_entries_are_one_line_naming_the_key(path, value, message):
+    with pytest.raises(UserInputError, match=message) as exc:
+        pl.parse_library(_edited(path, value))
+    assert "\n" not in str(exc.value)
+
+
+def test_unknown_polymorph_name_and_unresolved_wall_are_refused():
+    lib = pl.default_library()
+    with pytest.raises(UserInputError, match=r"^unknown polymorph 'curly2'; allowed: ecoli_normal"):
+        lib.polymorph("curly2")
+    t = lib.transition("salmonella_normal_semicoiled")
+    with pytest.raises(UserInputError, match=r"wall_width_um is a gap in the library"):
+        t.wall_width(bead_spacing_um=0.1)
+    assert t.wall_width(0.1, wall_width_um=0.5) == 0.5
+    with pytest.raises(UserInputError, match=r"^transition 'salmonella_normal_semicoiled': "
+                                             r"wall_width_um must be >= the bead spacing 0.1 "):
+        t.wall_width(0.1, wall_width_um=0.05)
+
+
+def test_library_file_errors_are_one_line(tmp_path):
+    with pytest.raises(UserInputError, match="polymorph library not found"):
+        pl.load_library_file(tmp_path / "nope.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[[polymorph]\n")
+    with pytest.raises(UserInputError, match="invalid TOML"):
+        pl.load_library_file(bad)
