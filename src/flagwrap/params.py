@@ -11,6 +11,7 @@ Units: lengths [m], moduli [Pa], viscosity [Pa s], density [kg m^-3], frequency 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -947,6 +948,88 @@ class Initial:
         return self == Initial()
 
 
+@functools.lru_cache(maxsize=1)
+def _polymorph_library():
+    """The packaged polymorph library, parsed once per process."""
+    from flagwrap.elasticity.polymorph_library import default_library
+
+    return default_library()
+
+
+@dataclass(frozen=True)
+class Polymorph:
+    """A polymorphic filament (docs/polymorph.md): an order parameter ``phi`` per bead,
+    ``-1`` the library's polymorph ``polymorph_a``, ``+1`` ``polymorph_b``, with the energy
+    (P3) ``sum_i v_i W (1 - phi_i^2)^2 / 4 + sum_j K / (2 l_j) (phi_{j+1} - phi_j)^2`` and the
+    first-order kinetics ``dphi_i/dt = -(Gamma / v_i) dE/dphi_i`` (continuum:
+    ``phi_t = -Gamma (W f'(phi) - K phi_ss)``).
+
+    ``barrier`` ``W`` [N] (energy per length), ``stiffness`` ``K`` [N m^2] (``units.bending``
+    applies), both required when enabled; ``rate`` ``Gamma`` [1/(N s)], not published: default
+    (None) ``Gamma = 5 omega / W``, a uniform well relaxing (rate ``2 Gamma W``) ten times per
+    radian of the reference motor turn, allowed ``(0, 1e6)`` times that; ``initial``: ``"a"``,
+    ``"b"`` (uniform) or ``"wall"`` (the tanh wall (P4) from A at the motor to B at the free
+    end, centred at ``wall_position`` of the contour).
+    """
+
+    enabled: bool = False
+    polymorph_a: str = "ecoli_normal"
+    polymorph_b: str = "ecoli_semicoiled"
+    barrier: float | None = None
+    stiffness: float | None = None
+    rate: float | None = None
+    initial: str = "a"
+    wall_position: float = 0.5
+
+    INITIAL = ("a", "b", "wall")
+    #: most ``rate`` may exceed its default by (a stiff but finite kinetics)
+    MAX_RATE_FACTOR = 1e6
+
+    def __post_init__(self):
+        if not isinstance(self.enabled, bool):
+            raise UserInputError(f"polymorph.enabled must be true or false, got {self.enabled!r}")
+        lib = _polymorph_library()
+        for key in ("polymorph_a", "polymorph_b"):
+            name = getattr(self, key)
+            try:
+                lib.polymorph(name).curvature_torsion_per_um()
+            except UserInputError as exc:
+                raise UserInputError(f"polymorph.{key}: {exc}") from None
+        for key in ("barrier", "stiffness", "rate"):
+            v = getattr(self, key)
+            if v is not None:
+                _positive(f"polymorph.{key}", v, {"barrier": "N", "stiffness": "N m^2",
+                                                   "rate": "1/(N s)"}[key])
+        if self.enabled:
+            for key, unit in (("barrier", "N"), ("stiffness", "N m^2")):
+                if getattr(self, key) is None:
+                    raise UserInputError(f"polymorph.{key} is required when polymorph.enabled "
+                                         f"= true (a value in (0, inf) {unit})")
+        if self.initial not in self.INITIAL:
+            raise UserInputError(f"polymorph.initial must be one of {', '.join(self.INITIAL)}, "
+                                 f"got {self.initial!r}")
+        v = _finite("polymorph.wall_position", self.wall_position)
+        if not 0.0 < v < 1.0:
+            raise UserInputError(f"polymorph.wall_position must be in (0, 1) (a fraction of "
+                                 f"the contour), got {self.wall_position!r}")
+
+    @property
+    def is_default(self) -> bool:
+        return self == Polymorph()
+
+    def wall_width(self) -> float:
+        """``w = sqrt(2 K / W)`` [m] of the tanh wall (P4)."""
+        return math.sqrt(2.0 * self.stiffness / self.barrier)
+
+    def core(self, scales) -> tuple[float, float, float]:
+        """``(W, K, Gamma)`` in core units (``W`` per ``A/L^2``, ``K`` per ``A``, ``Gamma`` per
+        ``L^2 / (A T)``); the default rate ``Gamma = 5 / W`` (core)."""
+        W = self.barrier / scales.force
+        K = self.stiffness / scales.bending
+        G = 5.0 / W if self.rate is None else self.rate * scales.force / scales.omega
+        return W, K, G
+
+
 @dataclass(frozen=True)
 class Config:
     """Everything that defines one run."""
@@ -960,6 +1043,8 @@ class Config:
     clamp: Clamp = field(default_factory=Clamp)
     initial: Initial = field(default_factory=Initial)
     joint: Joint = field(default_factory=Joint)
+    #: the polymorphic state (``[polymorph]``); default: off, the fixed-shape rod
+    polymorph: Polymorph = field(default_factory=Polymorph)
     #: one per flagellum (``[[flagellum]]``); empty: one flagellum at the pole
     flagella: tuple = ()
     #: no-slip plane walls (``[[wall]]``); empty: free space
@@ -977,6 +1062,7 @@ class Config:
             ("clamp", Clamp),
             ("initial", Initial),
             ("joint", Joint),
+            ("polymorph", Polymorph),
         ):
             if not isinstance(getattr(self, attr), cls):
                 raise UserInputError(f"config.{attr} must be a {cls.__name__}")
@@ -1010,6 +1096,8 @@ class Config:
                     f"{how} gives a cell body of radius {rc:.3g} m; it must be wider than the "
                     f"filament (> 2 a = {2 * a:.3g} m) and at most {MAX_BODY_OVER_LENGTH:g} L = "
                     f"{MAX_BODY_OVER_LENGTH * fil.length:.3g} m (or set body.enabled = false)")
+        if self.polymorph.enabled:
+            self._check_polymorph()
         if self.flagella:
             from flagwrap.system.parts import check_flagella
 
@@ -1207,6 +1295,22 @@ class Config:
     def replace(self, **changes) -> "Config":
         return dataclasses.replace(self, **changes)
 
+    def _check_polymorph(self) -> None:
+        """Refuse a ``[polymorph]`` this version cannot run (one line naming the key): its
+        wall narrower than a bond (unresolved, docs/polymorph.md), or a system the polymorph
+        state is not wired into yet (several flagella, a free body, the turning frame)."""
+        from flagwrap.elasticity.polymorph import check_wall_resolution
+
+        pm, fil = self.polymorph, self.filament
+        check_wall_resolution(pm.wall_width(), fil.bond_length,
+                              "polymorph wall width sqrt(2 stiffness / barrier) [m]")
+        for bad, what in ((len(self.flagella) > 1, "several [[flagellum]] tables"),
+                          (self.body.free, "body.motion = 'free'"),
+                          (self.numerics.frame != "lab", f"numerics.frame = {self.numerics.frame!r}")):
+            if bad:
+                raise UserInputError(f"polymorph.enabled = true is not available with {what} "
+                                     "yet (one filament in the lab frame)")
+
     def to_dict(self, for_hash: bool = False) -> dict:
         """Plain nested dict (JSON/TOML-able); ``None`` values are dropped.
 
@@ -1225,6 +1329,8 @@ class Config:
             return obj
 
         d = clean(self)
+        if self.polymorph.is_default:  # off: the config reads and hashes as before
+            d.pop("polymorph", None)
         # one table per flagellum, as the TOML has them ([[flagellum]]); none: the default
         fl = d.pop("flagella", [])
         if fl:

@@ -515,6 +515,10 @@ def make_system(config):
         from flagwrap.system.rotating import RotatingSystem
 
         system = RotatingSystem(system)
+    if config.polymorph.enabled:
+        from flagwrap.system.polymorph import PolymorphSystem
+
+        system = PolymorphSystem(system)
     return system
 
 

@@ -47,29 +47,44 @@ class RosenbrockW(AdaptiveMixin, Integrator):
         except SingularW as exc:
             return self.reject(h, f"singular W ({exc})")
         a, c = tb.a, tb.c
+        split = getattr(system, "stage_split", None)
         U = np.empty((tb.stages, system.ny))
         for i in range(tb.stages):
             if i == 0:
                 f = system.velocity(y, info, omega)
             else:
-                Yi = y + a[i, :i] @ U[:i]
+                Yi = y + _combine(a[i, :i], U[:i], split)
                 if not np.all(np.isfinite(Yi)):
                     return self.reject(h, "non-finite stage")
                 try:
                     f, _ = system.rhs(Yi, base, omega)
                 except ZeroDivisionError:  # a stage so far off that a bond has zero length
                     return self.reject(h, "degenerate stage (a bond of zero length)")
-            rhs = f + (c[i, :i] @ U[:i]) / h if i else f
+            rhs = f + _combine(c[i, :i], U[:i], split) / h if i else f
             try:
                 U[i] = W.solve(gh * rhs)
             except SingularW as exc:
                 return self.reject(h, str(exc))
-        y_new = y + tb.m @ U
-        err_vec = tb.e @ U
+        y_new = y + _combine(tb.m, U, split)
+        err_vec = _combine(tb.e, U, split)
         if self.filter_error:
             err_vec = W.solve(err_vec)
         err = scaled_error(system, err_vec, self.tol)
         return self.conclude(system, base, y_new, err, h, estimate_order=tb.estimate_order)
+
+
+def _combine(coef, U, split):
+    """``coef @ U``; with ``split`` (a system's ``stage_split``) the first ``split`` columns
+    and the rest as two products, so that the first ``split`` unknowns are combined exactly
+    as a system of only those would combine them (BLAS treats a vector's tail apart from its
+    body, so the same columns in a longer product may round differently). Systems without
+    ``stage_split`` take the one product, as always."""
+    if split is None:
+        return coef @ U
+    out = np.empty(U.shape[1])
+    out[:split] = coef @ U[:, :split]
+    out[split:] = coef @ U[:, split:]
+    return out
 
 
 class ROS34PW2(RosenbrockW):

@@ -25,7 +25,7 @@ else:  # pragma: no cover
 
 from flagwrap.errors import UserInputError
 from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Flagellum, Fluid, Wall,
-                             Initial, Joint, Motor, Numerics, Phase)
+                             Initial, Joint, Motor, Numerics, Phase, Polymorph)
 
 _SECTIONS = {
     "filament": Filament,
@@ -37,6 +37,7 @@ _SECTIONS = {
     "clamp": Clamp,
     "initial": Initial,
     "joint": Joint,
+    "polymorph": Polymorph,
 }
 _LENGTH = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "micron": 1e-6, "nm": 1e-9}
 _PRESSURE = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9}
@@ -138,6 +139,8 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
             scale.update(stall_torque=tf)
         if section == "joint":
             scale.update(hook_bending_modulus=bf, hook_twist_modulus=bf)
+        if section == "polymorph":
+            scale.update(stiffness=bf)
         for key, factor in scale.items():
             # numbers only: a bool times a factor would become a float and pass validation
             if _is_number(table.get(key)):
@@ -298,8 +301,8 @@ def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
     d = cfg.to_dict(for_hash=for_hash)
     lines = [f"name = {_toml_value(d.pop('name'))}", ""]
     for section in ("filament", "fluid", "body", "motor", "clamp", "contact", "numerics", "initial",
-                    "joint"):
-        if section in ("initial", "joint") and section not in d:
+                    "joint", "polymorph"):
+        if section in ("initial", "joint", "polymorph") and section not in d:
             continue  # omitted from the hashed text while it holds its defaults
         table = d.get(section, {})
         lines.append(f"[{section}]")

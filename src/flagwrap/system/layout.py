@@ -8,7 +8,9 @@ layout instead of assuming "positions first, then twists, the motor angle last".
 * ``"position"``: bead coordinates [L], error held to ``tol``;
 * ``"angle"``: twist angles [rad], error held to ``10 tol`` (a twist angle of 10 tol moves a
   bond's surface by 10 tol a, ~0.04 tol L at the paper's a/L: docs/numerics.md);
-* ``"prescribed"``: driven coordinates (the motor angle), no error (weight ``inf``).
+* ``"prescribed"``: driven coordinates (the motor angle), no error (weight ``inf``);
+* ``"order"``: a polymorph order parameter in ``[-1, 1]`` (docs/polymorph.md), error held to
+  ``tol`` (the wells are 2 apart).
 
 Filaments with clamps: ``[x_free (3 n_b), theta_free (n_e), phi (one per motor)]``
 (:meth:`DofLayout.clamped_filament`); a free body adds its pose.
@@ -20,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-KINDS = ("position", "angle", "prescribed")
+KINDS = ("position", "angle", "prescribed", "order")
 #: error tolerance of each kind, in units of the integrator's ``tol``
-TOL_FACTOR = {"position": 1.0, "angle": 10.0}
+TOL_FACTOR = {"position": 1.0, "angle": 10.0, "order": 1.0}
 
 
 @dataclass(frozen=True)

@@ -55,6 +55,8 @@ class ForceInfo:
     grad_theta: np.ndarray
     distance: np.ndarray
     interaction_energy: float = 0.0
+    #: the polymorph state's own energy (P3) (docs/polymorph.md), 0 without one
+    polymorph_energy: float = 0.0
 
 
 def motor_omega(omega, k: int) -> float:

@@ -1,0 +1,137 @@
+"""The polymorph state wired in as a layout block (flagwrap.system.polymorph): a config
+without [polymorph] is untouched, a one-state filament steps bit for bit as the fixed rod,
+the block relaxes to the discrete wall within the lattice error of the tanh profile (P4),
+and bad [polymorph] input is one line naming the key."""
+
+import numpy as np
+import pytest
+
+from conftest import tiny_toml
+from flagwrap.errors import UserInputError
+from flagwrap.io.config import config_from_dict, tomllib
+
+# W = 1e-3 N, K = 1e-6 N m^2: wall width sqrt(2 K / W) = 0.0447 m, 2.2 bonds of the tiny
+# 21-bead chain (b = 0.02 m)
+POLY = "[polymorph]\nenabled = true\nbarrier = 1e-3\nstiffness = 1e-6\n"
+
+
+def _cfg(extra="", **kw):
+    return config_from_dict(tomllib.loads(tiny_toml(**kw) + extra))
+
+
+def test_no_polymorph_section_reads_and_hashes_as_before():
+    cfg = _cfg()
+    assert not cfg.polymorph.enabled and cfg.polymorph.is_default
+    assert "polymorph" not in cfg.to_dict() and "polymorph" not in cfg.to_dict(for_hash=True)
+    from flagwrap.simulation import make_system
+    from flagwrap.system.rod_system import RodSystem
+
+    assert type(make_system(cfg)) is RodSystem
+
+
+def test_polymorph_config_round_trips():
+    from flagwrap.io.config import config_to_toml
+
+    cfg = _cfg(POLY + "initial = 'wall'\nrate = 2.0\n")
+    assert config_from_dict(tomllib.loads(config_to_toml(cfg))) == cfg
+
+
+def test_one_state_filament_steps_bit_for_bit_as_the_fixed_rod():
+    """Both polymorphs the same and phi uniform in a well: the order block's force is exactly
+    zero, and the rod's unknowns take the fixed rod's steps to the last bit."""
+    from flagwrap.simulation import make_system, simulate
+
+    plain = _cfg(ccw=0.1, cw=0.05)
+    one = _cfg(POLY + "polymorph_b = 'ecoli_normal'\n", ccw=0.1, cw=0.05)
+    assert type(make_system(one)).__name__ == "PolymorphSystem"
+    a, b = simulate(plain), simulate(one)
+    assert a.status == b.status == "completed"
+    assert (a.n_steps, a.n_rejected) == (b.n_steps, b.n_rejected)
+    assert np.array_equal(np.asarray(a.t), np.asarray(b.t))
+    assert np.array_equal(np.asarray(a.x), np.asarray(b.x))
+    assert np.array_equal(np.asarray(a.theta), np.asarray(b.theta))
+
+
+def _relax(system, t_end, h=0.02):
+    """Step the system with the default integrator at a fixed motor speed 0 (no load)."""
+    from flagwrap.integrators import REGISTRY
+
+    integ = REGISTRY["ros34pw2"](1e-6)
+    y = system.initial_y()
+    info = system.forces(y, system.frames0.copy())
+    t = 0.0
+    while t < t_end:
+        r = integ.step(system, y, info.frames, info, min(h, t_end - t), 0.0)
+        if r.accepted:
+            t += min(h, t_end - t)
+            y, info = r.y, r.info
+        h = r.h_next
+    return y, info
+
+
+def test_wall_relaxes_to_the_discrete_wall_near_the_tanh_profile():
+    """phi starts as the tanh wall (P4) in a rod at rest (motor still): the block relaxes to
+    the discrete wall of (P3), whose distance from tanh is the lattice error, second order
+    in b/w (docs/polymorph.md: max abs(phi - tanh) 2.3e-3 at b/w = 0.2, ~0.06 (b/w)^2). Here
+    b/w = 0.45 (a coarse chain, to stay fast), so the bound is 0.1 (b/w)^2 = 0.02, and the
+    wall's centre, pinned by symmetry, stays at mid-contour. The rate is the default, a well
+    relaxing at 2 Gamma W = 10 per unit time; t = 3 is 30 relaxation times."""
+    from flagwrap.simulation import make_system
+
+    cfg = _cfg(POLY + "initial = 'wall'\n")
+    system = make_system(cfg)
+    phi0 = system.order(system.initial_y()).copy()
+    y, info = _relax(system, 3.0)
+    phi = system.order(y)
+    s = np.concatenate([[0.0], np.cumsum(system.order_bonds)])
+    w = system.model.wall_width
+    b = system.order_bonds[0]
+    tanh = np.tanh((s - 0.5 * s[-1]) / w)
+    assert np.array_equal(phi0, tanh)
+    err = np.abs(phi - tanh).max()
+    assert err < 0.1 * (b / w) ** 2, err
+    # antisymmetric about the centre (the wall did not drift)
+    assert np.abs(phi + phi[::-1]).max() < 1e-6
+    # at rest: the generalized force on phi vanishes, the energy is below the tanh's
+    assert np.abs(info.G[system.sl_order]).max() < 1e-5 * system.model.barrier
+    from flagwrap.elasticity.polymorph import total_energy
+
+    e_tanh = total_energy(tanh, system.model, 0.0, system.order_vor, system.order_bonds)
+    assert info.polymorph_energy <= e_tanh
+    # the rod stays at rest (uncoupled, no load; the rest shape's round-off forces only)
+    assert np.abs(y[:system.n_rod] - system.initial_y()[:system.n_rod]).max() < 1e-9
+
+
+@pytest.mark.parametrize("extra, key", [
+    ("polymorph_a = 'nope'\n", "polymorph.polymorph_a"),
+    ("polymorph_b = 'ecoli_coiled'\n", "polymorph.polymorph_b"),
+    ("rate = -1.0\n", "polymorph.rate"),
+    ("initial = 'c'\n", "polymorph.initial"),
+    ("wall_position = 1.0\n", "polymorph.wall_position"),
+])
+def test_bad_polymorph_input_is_one_line_naming_the_key(extra, key):
+    with pytest.raises(UserInputError) as exc:
+        _cfg(POLY + extra)
+    msg = str(exc.value)
+    assert key in msg and "\n" not in msg
+
+
+def test_missing_barrier_and_narrow_wall_are_refused():
+    with pytest.raises(UserInputError, match="polymorph.barrier is required"):
+        _cfg("[polymorph]\nenabled = true\nstiffness = 1e-6\n")
+    with pytest.raises(UserInputError, match="polymorph wall width"):
+        _cfg("[polymorph]\nenabled = true\nbarrier = 1e-3\nstiffness = 1e-8\n")
+
+
+def test_cli_exit_2_names_the_key(tmp_path):
+    import subprocess
+    import sys
+
+    p = tmp_path / "bad.toml"
+    p.write_text(tiny_toml() + POLY + "rate = -3\n")
+    r = subprocess.run([sys.executable, "-m", "flagwrap.cli.main", "run", str(p), "-o",
+                        str(tmp_path / "o.nc")], capture_output=True, text=True,
+                       env={**__import__("os").environ,
+                            "PYTHONPATH": str(__import__("pathlib").Path(__file__).parents[2] / "src")})
+    assert r.returncode == 2, r.stderr
+    assert "polymorph.rate" in r.stderr
