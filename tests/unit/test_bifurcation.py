@@ -156,7 +156,10 @@ def test_hook_and_buoyancy_are_accepted_and_answered(tiny, capsys, extra):
         text = text.replace("n_beads = 21", "n_beads = 21\ndensity_mismatch = 0.005")
     path = tiny / f"kind_{'hook' if extra else 'buoyant'}.toml"
     path.write_text(text)
-    code = main(["stability", str(path), "--far", "--json", "--cycles", "none", "--settle", "10"])
+    # --m-hi just above each one's whirl threshold (hook 307, buoyant 1210): one reversal tried
+    m_hi = "340" if extra else "1300"
+    code = main(["stability", str(path), "--far", "--json", "--cycles", "none", "--settle", "10",
+                 "--m-hi", m_hi])
     out, err = capsys.readouterr()
     s = json.loads(out)
     assert code in (0, 1), err
@@ -175,7 +178,7 @@ def test_fig4a_far_state_at_660_and_its_fold():
     from flagwrap.cases import get_case
     from flagwrap.stability.bifurcation import bifurcation_diagram
 
-    d = bifurcation_diagram(get_case("fig4a"), m_far=660.0, m_hi=700.0, cycles=())
+    d = bifurcation_diagram(get_case("fig4a"), m_far=660.0, m_hi=700.0, cycles=(), factor=1.15)
     start = min(d.far, key=lambda p: abs(p.machin - 660.0))
     assert start.machin == pytest.approx(660.0)
     assert start.state.residual < 1e-10 and start.leading.real < 0

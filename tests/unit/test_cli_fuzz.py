@@ -243,6 +243,8 @@ def _mot(line):
 HOOK = "\n[joint]\nkind = 'hook'\nhook_length = 0.004\nhook_bending_modulus = 1e-8\n"
 FREE = "\n[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n"
 FLAG = "\n[[flagellum]]\npolar_deg = 30\nazimuth_deg = 0\n"
+POLY = ("[polymorph]\nenabled = true\npolymorph_a = 'ecoli_normal'\npolymorph_b = 'ecoli_semicoiled'\n"
+        "barrier = 1e-12\nstiffness = 1e-24\n")
 WALL = "\n[[wall]]\npoint = [0.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 1.0]\n"
 
 CONFIGS = [
@@ -306,6 +308,11 @@ CONFIGS = [
     ("wall", tiny_toml() + WALL.replace("[0.0, 0.0, -0.5]", "'below'"), "point"),
     ("wall", tiny_toml() + WALL.replace("-0.5]", "1e308]"), "point"),
     ("units", tiny_toml().replace('name = "tiny"', 'name = "tiny"\n[units]\nbending = "furlong"'), "units.bending"),
+    ("polymorph", tiny_toml() + POLY.replace("'ecoli_semicoiled'", "'ecoli_square'"), "polymorph.polymorph_b"),
+    ("polymorph", tiny_toml() + POLY + "rate = -1.0\n", "polymorph.rate"),
+    ("polymorph", tiny_toml() + POLY.replace("barrier = 1e-12\n", ""), "polymorph.barrier"),
+    ("polymorph", tiny_toml() + POLY.replace("enabled = true", "enabled = 'yes'"), "polymorph.enabled"),
+    ("polymorph", tiny_toml() + POLY + "wall_position = 1.5\n", "polymorph.wall_position"),
 ]
 
 
