@@ -242,9 +242,7 @@ def run(args) -> int:
     print(f"steady shape at M_c: free end {(tip - res.tip_z0):+.4f} L above its rest height "
           f"({(tip - res.tip_z0) * L * scale:+.3g} {unit})")
     print(f"M_c / scaling line 0.06 (R/L)^-3 = {res.machin_c / cfg.machin_critical_scaling:.2f}")
-    tq = s["torque_c"]
-    si = f"{tq * 1e21:.4g} pN nm" if L < 1e-3 else f"{tq:.3g} N m"  # a bacterium or the rig
-    print(f"motor torque of the whirl at M_c: {s['torque_c_reduced']:.3f} A/R = {si} (the "
+    print(f"motor torque of the whirl at M_c: {_torque_text(cfg, t_core)} (the "
           "paper's scaling estimate: N_c ~ 0.5 A/R)")
     if res.growth_slope > 0:
         print(f"growth above M_c: d Re(lambda)/d eps = {res.growth_slope:.3g} omega (eps = "
@@ -383,7 +381,7 @@ def _run_far(args, cfg) -> int:
     import json
     import sys
 
-    from flagwrap.stability.bifurcation import FarStateNotFound, bifurcation_diagram, state_torque
+    from flagwrap.stability.bifurcation import FarStateNotFound, bifurcation_diagram
 
     progress = not (args.json or args.no_progress)
 
@@ -417,12 +415,7 @@ def _run_far(args, cfg) -> int:
     s.update(config=str(args.config), hydrodynamics=cfg.numerics.hydrodynamics,
              machin_critical_scaling=cfg.machin_critical_scaling)
     fil = cfg.filament
-    tq = {}
-    if d.hopf.state is not None:
-        tq["hopf"] = state_torque(d.hopf.frame, d.hopf.state)
-    fold_state = _fold_state(d)
-    if fold_state is not None:
-        tq["fold"] = state_torque(d.hopf.frame, fold_state)
+    tq = d.torques()
     for k, v in tq.items():
         s[f"torque_{k}_reduced"] = v * fil.helix_radius / fil.length
         s[f"torque_{k}"] = v * fil.bending_modulus / fil.length
@@ -464,8 +457,3 @@ def _run_far(args, cfg) -> int:
         print(f"wrote {f_}")
     return 0 if d.fold_found else 1
 
-
-def _fold_state(d):
-    """The far state nearest the fold (the last one above it on the stable side)."""
-    stable = [p for p in d.far if p.state is not None]
-    return min(stable, key=lambda p: p.machin).state if stable else None

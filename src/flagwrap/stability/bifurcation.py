@@ -290,6 +290,21 @@ class Diagram:
     def fold_found(self) -> bool:
         return math.isfinite(self.machin_fold)
 
+    def torques(self) -> dict:
+        """|motor torque| [A/L] (:func:`~flagwrap.stability.threshold.state_torque`) of the
+        whirl at the top of its threshold's bracket (``"hopf"``) and of the lowest far state,
+        the one nearest the fold (``"fold"``), where they exist."""
+        from flagwrap.stability.threshold import state_torque
+
+        out = {}
+        if self.hopf is not None and self.hopf.state is not None:
+            out["hopf"] = state_torque(self.hopf.frame, self.hopf.state)
+        lowest = [p for p in self.far if p.state is not None]
+        if lowest:
+            out["fold"] = state_torque(self.hopf.frame,
+                                       min(lowest, key=lambda p: p.machin).state)
+        return out
+
     def summary(self) -> dict:
         def pts(ps):
             return [{"machin": p.machin, "tip_z": p.tip_z, "leading_re": p.leading.real,
@@ -469,7 +484,7 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     work) and :class:`FarStateNotFound` when no far state is found (the diagram so far in
     its ``diagram`` attribute)."""
     from flagwrap.stability.spectrum import mode_vector, spectrum
-    from flagwrap.stability.threshold import DIRECTIONS, critical_from_config
+    from flagwrap.stability.threshold import DIRECTIONS, critical_from_config, speed_driven
 
     check_diagram_options(m_far, m_lo, m_hi, settle, factor, cycles)
     if direction not in DIRECTIONS:
@@ -493,9 +508,7 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     say = on_progress or (lambda line: None)
     # a step along the branch starts next to the new state: half the search's turns do
     step_turns = max(5.0, settle / 2)
-    if config.motor.kind != "speed":
-        config = config.replace(motor=dataclasses.replace(
-            config.motor, kind="speed", stall_torque=None, zero_load_speed=None))
+    config = speed_driven(config)
     m_guess = 30.0 * config.machin_critical_scaling if m_hi is None else m_hi
     hopf = critical_from_config(config, direction, m_start=min(m_start, m_guess / 2),
                                 m_max=max(m_guess, 2 * m_start))
@@ -670,10 +683,3 @@ def _not_found(diagram, message):
     exc.diagram = diagram
     return exc
 
-
-def state_torque(frame, state) -> float:
-    """|torque| the motor supplies to a steady state (core units ``A/L``): the system's own
-    torque balance, its drag term taken at the state's M
-    (:func:`flagwrap.stability.threshold.whirl_torque`)."""
-    s = frame.system
-    return abs(s.motor_torque(state.info, 0.0, frame.omega * state.machin / s.machin))

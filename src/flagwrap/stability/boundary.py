@@ -53,16 +53,12 @@ def helix_threshold(item, m_factor: float = 30.0, rtol: float = 1e-3, far: bool 
                 d = exc.diagram
                 extra = {"far_found": False, "far_message": str(exc)}
             r = d.hopf
-            from flagwrap.stability.bifurcation import state_torque
-
-            fil = cfg.filament
-            reduced = fil.helix_radius / fil.length  # A/L -> A/R
-            lowest = min(d.far, key=lambda p: p.machin, default=None)
+            reduced = cfg.filament.helix_radius / cfg.filament.length  # A/L -> A/R
+            tq = d.torques()
             extra.update(
-                torque_c_reduced=(state_torque(r.frame, r.state) * reduced
-                                  if r.state is not None else None),
-                torque_fold_reduced=(state_torque(r.frame, lowest.state) * reduced
-                                     if d.fold_found and lowest is not None else None),
+                torque_c_reduced=tq["hopf"] * reduced if "hopf" in tq else None,
+                torque_fold_reduced=(tq["fold"] * reduced
+                                     if d.fold_found and "fold" in tq else None),
                 machin_fold=d.machin_fold if d.fold_found else None,
                          fold_eigenvalues=[v if math.isfinite(v) else None
                                            for v in d.fold_eigenvalues],

@@ -299,13 +299,8 @@ def critical_from_config(config, direction: str = "cw", m_start: float = 10.0, m
     at its reference frequency for the threshold, and the result gets ``res.motor``
     (:func:`motor_verdict`): whether that motor can drive the whirl past it. ``on_start(m_max)``
     is called once the system is built and accepted (a progress display's first line)."""
-    import dataclasses
-
-    drive = None
-    if config.motor.kind != "speed":
-        drive = config.motor
-        config = config.replace(motor=dataclasses.replace(drive, kind="speed", stall_torque=None,
-                                                          zero_load_speed=None))
+    drive = config.motor if config.motor.kind != "speed" else None
+    config = speed_driven(config)
     m_max = resolve_m_max(config, m_start, m_max)
     frame = make_frame(config, DIRECTIONS[direction])
     if on_start is not None:  # the system is built and fits the turning frame
@@ -329,16 +324,32 @@ def onset_prefactor(growth_slope: float, seed: float = 1e-3, rise: float = 0.15)
     return math.log(rise / seed) / (2 * math.pi * growth_slope)
 
 
-def whirl_torque(res) -> float:
-    """|torque| the motor supplies to the steady whirl at the top of ``res``'s bracket (core
-    units ``A/L``): the clamp's generalized force ``dE/dphi`` plus the clamped bond's
-    rotational drag at that M (:meth:`~flagwrap.system.rod_system.RodSystem.motor_torque`)."""
-    if res.state is None:
-        return math.nan
-    frame, st = res.frame, res.state
+def state_torque(frame, state) -> float:
+    """|torque| the motor supplies to a steady state of ``frame`` (core units ``A/L``): the
+    clamp's generalized force ``dE/dphi`` plus the clamped bond's rotational drag at the
+    state's M (:meth:`~flagwrap.system.rod_system.RodSystem.motor_torque`)."""
     s = frame.system
     # the system's own torque balance; its drag term M zeta omega taken at the state's M
-    return abs(s.motor_torque(st.info, 0.0, frame.omega * st.machin / s.machin))
+    return abs(s.motor_torque(state.info, 0.0, frame.omega * state.machin / s.machin))
+
+
+def whirl_torque(res) -> float:
+    """|torque| the motor supplies to the steady whirl at the top of ``res``'s bracket (core
+    units ``A/L``; :func:`state_torque`)."""
+    if res.state is None:
+        return math.nan
+    return state_torque(res.frame, res.state)
+
+
+def speed_driven(config):
+    """``config`` with a torque or torque-speed motor replaced by a speed motor at its
+    reference frequency (a steady state is defined at a given speed); unchanged otherwise."""
+    import dataclasses
+
+    if config.motor.kind == "speed":
+        return config
+    return config.replace(motor=dataclasses.replace(config.motor, kind="speed",
+                                                    stall_torque=None, zero_load_speed=None))
 
 
 def motor_verdict(motor, config, res) -> dict:
