@@ -74,11 +74,12 @@ def test_wall_relaxes_to_the_discrete_wall_near_the_tanh_profile():
     the discrete wall of (P3), whose distance from tanh is the lattice error, second order
     in b/w (docs/polymorph.md: max abs(phi - tanh) 2.3e-3 at b/w = 0.2, ~0.06 (b/w)^2). Here
     b/w = 0.45 (a coarse chain, to stay fast), so the bound is 0.1 (b/w)^2 = 0.02, and the
-    wall's centre, pinned by symmetry, stays at mid-contour. The rate is the default, a well
+    wall's centre, pinned by symmetry, stays at mid-contour. Both polymorphs are the same
+    shape, so the rod does not push on phi and the wall is (P3)'s alone. The rate is the default, a well
     relaxing at 2 Gamma W = 10 per unit time; t = 3 is 30 relaxation times."""
     from flagwrap.simulation import make_system
 
-    cfg = _cfg(POLY + "initial = 'wall'\n")
+    cfg = _cfg(POLY + "initial = 'wall'\npolymorph_b = 'ecoli_normal'\n")
     system = make_system(cfg)
     phi0 = system.order(system.initial_y()).copy()
     y, info = _relax(system, 3.0)
@@ -98,7 +99,7 @@ def test_wall_relaxes_to_the_discrete_wall_near_the_tanh_profile():
 
     e_tanh = total_energy(tanh, system.model, 0.0, system.order_vor, system.order_bonds)
     assert info.polymorph_energy <= e_tanh
-    # the rod stays at rest (uncoupled, no load; the rest shape's round-off forces only)
+    # the rod stays at rest (one rest shape, no load; the rest shape's round-off forces only)
     assert np.abs(y[:system.n_rod] - system.initial_y()[:system.n_rod]).max() < 1e-9
 
 
@@ -135,3 +136,96 @@ def test_cli_exit_2_names_the_key(tmp_path):
                             "PYTHONPATH": str(__import__("pathlib").Path(__file__).parents[2] / "src")})
     assert r.returncode == 2, r.stderr
     assert "polymorph.rate" in r.stderr
+
+
+# --- the rod's rest shape follows phi (docs/polymorph.md, "Wiring") ---------------------
+def test_order_force_is_minus_the_gradient_of_the_total_energy():
+    """``G_order`` against central differences of the rod's elastic energy plus (P3), at a
+    bent and twisted rod with a random phi field (both polymorphs differ: normal ->
+    semicoiled). Step 1e-6: truncation ~1e-12 and round-off ~1e-16/1e-6 relative, so 1e-6
+    relative is a loose bound that a missing term (e.g. the twist part, ~30 % here) fails."""
+    from flagwrap.simulation import make_system
+
+    s = make_system(_cfg(POLY))
+    rng = np.random.default_rng(0)
+    y = s.initial_y()
+    y[:s.i_phi] += 1e-3 * rng.standard_normal(s.i_phi)
+    y[s.sl_order] = rng.uniform(-1.0, 1.0, s.N)
+    base = s.frames0.copy()
+    G = s.forces(y, base).G[s.sl_order].copy()
+
+    def energy(yy):
+        i = s.forces(yy, base)
+        return i.elastic_energy + i.polymorph_energy
+
+    h = 1e-6
+    for k in range(s.N):
+        yp, ym = y.copy(), y.copy()
+        yp[s.sl_order.start + k] += h
+        ym[s.sl_order.start + k] -= h
+        fd = -(energy(yp) - energy(ym)) / (2 * h)
+        assert abs(fd - G[k]) < 1e-6 * max(1.0, abs(G[k])), (k, fd, G[k])
+
+
+def test_polymorph_b_in_a_material_frames_is_stress_free():
+    """The rest pair (``rest_pair``): B's own helix (its positions from the library's ratios),
+    carrying A's material frames (its twist-free frames turned by ``c`` per bond, matched at
+    one vertex), has zero bending and twist energy under the rest at ``phi = +1`` on every
+    transforming vertex, and A's rest costs it O(1): normal (left) -> semicoiled (right), the
+    handedness flip."""
+    import dataclasses
+
+    from flagwrap.elasticity.rod import elastic_energy, initial_frames, rest_state
+    from flagwrap.geometry.helix import helix_positions
+    from flagwrap.simulation import make_system
+    from flagwrap.system.polymorph import _angles, polymorph_geometry
+
+    cfg = _cfg(POLY)
+    s = make_system(cfg)
+    L = cfg.filament.length
+    R, P, hand = polymorph_geometry(cfg)
+    assert hand == "right" and R == cfg.filament.helix_radius
+    assert P == pytest.approx(0.5 * cfg.filament.pitch)  # semicoiled: half the normal pitch
+    xb = helix_positions(1.0, R / L, P / L, s.N, hand)
+    fb = initial_frames(xb)
+    rb = rest_state(xb, fb, np.zeros(s.N - 1))
+    c = (s.mbar_b - s.mbar_a)[s.order_changes]
+    assert np.ptp(c) < 1e-15 and c[0] != 0.0
+    c, i = c[0], 5
+    theta = _angles(rb.kbar)[i] - _angles(s.kbar_a)[i] - (i - 0.5) * c + c * np.arange(s.N - 1)
+    mask = s.order_changes
+    rest = s.parts[0].rest
+    only = dict(stretch=0.0, cbend=np.where(mask, rest.cbend, 0.0),
+                ctwist=np.where(mask, rest.ctwist, 0.0))
+    e_b = elastic_energy(xb, theta, fb, dataclasses.replace(rest, kbar=s.kbar_b, mbar=s.mbar_b,
+                                                              **only))
+    e_a = elastic_energy(xb, theta, fb, dataclasses.replace(rest, kbar=s.kbar_a, mbar=s.mbar_a,
+                                                              **only))
+    assert e_b < 1e-24 and e_a > 1.0, (e_b, e_a)
+
+
+def test_rod_at_phi_one_relaxes_to_polymorph_b():
+    """A right-handed semicoiled rod switched to curly I (half the radius, same pitch and
+    hand: ``initial = 'b'``), motor still: the rod relaxes to B's helix (its pairwise bead
+    distances to 1e-8 L, B's positions built independently by ``helix_positions``), phi stays
+    at +1 and the elastic energy vanishes."""
+    from scipy.spatial.distance import pdist
+
+    from flagwrap.geometry.helix import helix_positions
+    from flagwrap.simulation import make_system
+    from flagwrap.system.polymorph import polymorph_geometry
+
+    cfg = config_from_dict(tomllib.loads(
+        tiny_toml().replace("turns = 2\n", "turns = 2\nhandedness = 'right'\n") + POLY
+        + "polymorph_a = 'ecoli_semicoiled'\npolymorph_b = 'ecoli_curly1'\ninitial = 'b'\n"))
+    s = make_system(cfg)
+    y, info = _relax(s, 50.0)
+    x = s.unpack(y)[0]
+    L = cfg.filament.length
+    R, P, hand = polymorph_geometry(cfg)
+    assert R == pytest.approx(0.5 * cfg.filament.helix_radius) and P == cfg.filament.pitch
+    xb = helix_positions(1.0, R / L, P / L, s.N, hand)
+    assert np.abs(pdist(x[1:]) - pdist(xb[1:])).max() < 1e-8
+    assert np.abs(pdist(x[1:]) - pdist(s.x0[1:])).max() > 0.1  # it did move
+    assert np.abs(s.order(y) - 1.0).max() < 1e-8
+    assert info.elastic_energy < 1e-12

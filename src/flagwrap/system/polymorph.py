@@ -24,11 +24,15 @@ a fixed point. The block's Jacobian is ``-Hess E`` (tridiagonal,
 :func:`~flagwrap.elasticity.polymorph.total_energy_hessian_bands`) and its mobility
 ``diag(Gamma / v_i)``.
 
-**Not wired yet** (docs/polymorph.md, "Wiring"): the rod's rest curvature and twist do not
-follow ``phi`` and the rod's elastic energy does not push on it (``elastic_phi_gradient``),
-so the block relaxes on its own and the rod moves exactly as the fixed-shape rod; the stage
-solver is the rod's own on the first ``n_rod`` unknowns plus a tridiagonal solve of the
-block (``W`` is block diagonal while the two are uncoupled).
+**Coupling to the rod** (docs/polymorph.md, "Wiring"): each vertex's rest curvature and
+twist follow its ``phi`` (:func:`~flagwrap.elasticity.polymorph.interpolate_rest` between
+the two polymorphs' rest values on the rod's own chain, :func:`rest_pair`), rewritten into
+the filament's rest arrays before every evaluation; the rod's elastic energy pushes on
+``phi`` (``-dE_el/dphi``, :func:`~flagwrap.elasticity.polymorph.elastic_phi_gradient`), so the
+axial moment tilts the double well (P2) through the rod's own twist. The stage solver's ``W``
+keeps the rod's own block and the block's tridiagonal ``I + gamma h Mob (Hess E + diag
+d2E_el/dphi2)``; the rod-state cross terms are left out, which a W-method allows (its order
+holds for any ``W``; only the step-size control feels it).
 """
 
 from __future__ import annotations
@@ -36,9 +40,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from flagwrap.elasticity import _kernels as EK
 from flagwrap.elasticity.polymorph import (PolymorphModel, total_energy,
                                            total_energy_grad, total_energy_hessian_bands,
                                            wall_profile)
+from flagwrap.elasticity.rod import initial_frames, rest_state
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.rod_system import RodSystem
 
@@ -52,6 +58,80 @@ def voronoi_lengths(l0) -> np.ndarray:
     return v
 
 
+def polymorph_geometry(config):
+    """Polymorph B's helix ``(R_B, P_B, handedness_B)`` [m] for the configured filament, which
+    is polymorph A: the library's ratios applied to the filament's own helix,
+    ``R_B = R (R_b / R_a)``, ``P_B = P (P_b / P_a)``, the handedness flipped when the two
+    library forms differ in it. A filament built with A's library geometry gets B's library
+    geometry exactly; a scaled rig (e.g. the paper's macroscopic helix) keeps the ratios."""
+    from flagwrap.elasticity.polymorph_library import default_library
+
+    lib = default_library()
+    pm, fil = config.polymorph, config.filament
+    a, b = lib.polymorph(pm.polymorph_a), lib.polymorph(pm.polymorph_b)
+    hand = fil.handedness
+    if a.handedness.value != b.handedness.value:
+        hand = "right" if hand == "left" else "left"
+    return (fil.helix_radius * b.radius_um.value / a.radius_um.value,
+            fil.pitch * b.pitch_um.value / a.pitch_um.value, hand)
+
+
+def _angles(kbar):
+    return np.arctan2(kbar[:, 1], kbar[:, 0])
+
+
+def rest_pair(part, config):
+    """The rest values ``(kbar_a, kbar_b, mbar_a, mbar_b, changes)`` of the filament ``part``
+    in polymorph A (its own rest, the configured helix) and B (:func:`polymorph_geometry`),
+    both in the material frame of A's chain: the material keeps the azimuth at which it
+    bends. In the twist-free gauge the rod is built in, a uniform helix's rest curvature has
+    the magnitude ``k`` and its angle advances by ``d`` per vertex (its discrete curvature and
+    torsion on the chain's bond; medians over a helix's interior). B, carried in A's
+    material frames with the curvature's angle kept, twists by ``c = d_B - d_A`` per vertex
+    (B's rest twist is A's plus ``c``) and its rest curvature is A's times
+    ``k_B cos(c/2) / k_A`` (the kernel measures the curvature in the average of the two
+    bonds' material frames, which the twist turns ``c`` apart). The rod at ``phi = +1``
+    relaxes to B's helix exactly (tested). ``changes`` (N,) bool: the vertices that transform, the
+    filament's interior vertices on bonds of the nominal length, not a joint's (a hook is
+    not flagellin) nor a lumped joint's angle-law vertex."""
+    from flagwrap.geometry.helix import helix_positions
+
+    rest = part.rest
+    fil = config.filament
+    L = fil.length
+    b = fil.bond_length / L
+    N = part.N
+    changes = np.zeros(N, bool)
+    nominal = np.abs(rest.l0 - b) < 1e-6 * b
+    changes[1:-1] = nominal[:-1] & nominal[1:]
+    changes &= ~rest.angle_law
+    changes[:part.nc] = False  # the joint's held vertices
+    mag_a = np.hypot(rest.kbar[:, 0], rest.kbar[:, 1])
+    changes &= mag_a > 1e-12 * b
+    kbar_a, mbar_a = rest.kbar.copy(), rest.mbar.copy()
+    if not changes.any():
+        return kbar_a, kbar_a.copy(), mbar_a, mbar_a.copy(), changes
+
+    def uniform(R, P, hand):
+        """A uniform helix's discrete rest ``(|kbar|, d alpha per vertex)`` on this bond."""
+        n = max(9, min(N, 41))
+        x = helix_positions(b * (n - 1), R / L, P / L, n, hand)
+        r = rest_state(x, initial_frames(x), np.zeros(n - 1))
+        k = r.kbar[2:-2]
+        da = np.angle(np.exp(1j * np.diff(_angles(k))))
+        return float(np.median(np.hypot(k[:, 0], k[:, 1]))), float(np.median(da))
+
+    RB, PB, hand_b = polymorph_geometry(config)
+    ka, da_a = uniform(fil.helix_radius, fil.pitch, fil.handedness)
+    kb, da_b = uniform(RB, PB, hand_b)
+    kbar_b, mbar_b = kbar_a.copy(), mbar_a.copy()
+    # the twist c = da_b - da_a between a vertex's two bonds turns their material frames
+    # apart, and the kernel's curvature, measured in their average, shrinks by cos(c/2)
+    kbar_b[changes] *= kb * np.cos(0.5 * (da_b - da_a)) / ka
+    mbar_b[changes] += da_b - da_a
+    return kbar_a, kbar_b, mbar_a, mbar_b, changes
+
+
 class PolymorphSystem(RodSystem):
     """``system`` (one filament, lab frame) with the order block (module docstring), from
     ``system.config.polymorph`` or the core-unit ``barrier``, ``stiffness``, ``rate`` and
@@ -60,10 +140,32 @@ class PolymorphSystem(RodSystem):
     def __init__(self, system, barrier=None, stiffness=None, rate=None, order0=None):
         if len(system.parts) != 1 or system.ny != system.n_rod:
             raise ValueError("PolymorphSystem: one filament without a free body")
+        import copy
+        import dataclasses
+
         rod = object.__new__(RodSystem)  # the rod's own view: its stage solvers see n_rod
         rod.__dict__.update(system.__dict__)
-        self.__dict__.update(system.__dict__)  # the same parts and buffers: a view
+        self.__dict__.update(system.__dict__)  # the same buffers: a view
         self._rod = rod
+        # the filament's rest arrays are rewritten from phi at every evaluation: its own
+        # copy, so the system it was made from keeps its fixed rest shape
+        part = copy.copy(system.parts[0])
+        part.rest = dataclasses.replace(part.rest, kbar=part.rest.kbar.copy(),
+                                        mbar=part.rest.mbar.copy())
+        self.parts = rod.parts = [part]
+        (self.kbar_a, self.kbar_b, self.mbar_a, self.mbar_b,
+         self.order_changes) = rest_pair(part, system.config)
+        #: ``d kbar/dphi``, ``d mbar/dphi`` (:func:`~flagwrap.elasticity.polymorph.rest_derivative`)
+        self._kbar_ba, self._mbar_ba = self.kbar_b - self.kbar_a, self.mbar_b - self.mbar_a
+        self.dkbar = 0.5 * (self.kbar_b - self.kbar_a)
+        self.dmbar = 0.5 * (self.mbar_b - self.mbar_a)
+        # d2 E_el / dphi2 at each vertex, constant: the energy is quadratic in the rest values
+        self.order_elastic_curvature = (part.rest.cbend * np.sum(self.dkbar**2, axis=1)
+                                        + part.rest.ctwist * self.dmbar**2)
+        n = part.N
+        self._m1, self._m2 = np.empty((n - 1, 3)), np.empty((n - 1, 3))
+        self._kb, self._kappa = np.zeros((n, 3)), np.zeros((n, 2))
+        self._twist = np.zeros(n)
         pm = system.config.polymorph
         W, K, G = pm.core(system.scales) if pm.enabled else (None, None, None)
         W = W if barrier is None else float(barrier)
@@ -116,13 +218,41 @@ class PolymorphSystem(RodSystem):
         return y[self.sl_order]
 
     # forces and mobility ----------------------------------------------------------------------
+    def set_rest(self, y) -> None:
+        """Write the rest curvature and twist at ``y``'s order parameters into the
+        filament's rest arrays (``a + (phi + 1)/2 (b - a)``, bit for bit ``a`` where the two
+        polymorphs coincide): every evaluation of the rod at ``y`` starts here."""
+        rest = self.parts[0].rest
+        t = 0.5 * (y[self.sl_order] + 1.0)
+        np.multiply(t[:, None], self._kbar_ba, out=rest.kbar)
+        np.add(rest.kbar, self.kbar_a, out=rest.kbar)
+        np.multiply(t, self._mbar_ba, out=rest.mbar)
+        np.add(rest.mbar, self.mbar_a, out=rest.mbar)
+
+    def elastic_order_gradient(self, info) -> np.ndarray:
+        """``dE_el/dphi_i`` at the state of ``info`` (rest set at its ``phi``):
+        ``-cbend_i (kappa_i - kbar_i).dkbar_i - ctwist_i (m_i - mbar_i) dmbar_i``
+        (:func:`~flagwrap.elasticity.polymorph.elastic_phi_gradient`), with the material
+        curvatures and twists the kernel measures (:mod:`flagwrap.elasticity._kernels`)."""
+        rest = self.parts[0].rest
+        fr = info.frames
+        EK.material_frames(fr.t, fr.d1, info.theta, self._m1, self._m2)
+        EK.curvatures(fr.t, self._m1, self._m2, self._kb, self._kappa)
+        m = self._twist
+        m[1:-1] = info.theta[1:] - info.theta[:-1] + fr.rt[1:-1]
+        out = -rest.cbend * np.sum((self._kappa - rest.kbar) * self.dkbar, axis=1)
+        out -= rest.ctwist * (m - rest.mbar) * self.dmbar
+        return out
+
     def forces(self, y, base):
-        """The rod's forces (its rows computed as the rod's, the block's zeroed by the
-        fused evaluation) and the block's ``G = -dE/dphi`` (P3)."""
+        """The rod's forces at the rest shape of ``y``'s ``phi`` and the block's
+        ``G = -dE/dphi`` of (P3) plus the rod's elastic energy."""
+        self.set_rest(y)
         info = RodSystem.forces(self, y, base)
         phi = y[self.sl_order]
         info.G[self.sl_order] = -total_energy_grad(phi, self.model, 0.0, self.order_vor,
                                                    self.order_bonds)
+        info.G[self.sl_order] -= self.elastic_order_gradient(info)
         info.polymorph_energy = total_energy(phi, self.model, 0.0, self.order_vor,
                                              self.order_bonds)
         return info
@@ -148,8 +278,7 @@ class PolymorphSystem(RodSystem):
     # Jacobian and stage solves ---------------------------------------------------------
     def order_jacobian_coo(self, y):
         """``-Hess E`` of the block (P3) as triplets over ``y``."""
-        main, off = total_energy_hessian_bands(y[self.sl_order], self.model, self.order_vor,
-                                               self.order_bonds)
+        main, off = self.order_hessian_bands(y)
         i0 = self.sl_order.start
         d = i0 + np.arange(len(main))
         o = d[:-1]
@@ -157,7 +286,17 @@ class PolymorphSystem(RodSystem):
         cols = np.concatenate([d, o + 1, o])
         return rows, cols, -np.concatenate([main, off, off])
 
+    def order_hessian_bands(self, y):
+        """The block's Hessian (tridiagonal): (P3)'s plus the rod's ``d2E_el/dphi_i2``."""
+        main, off = total_energy_hessian_bands(y[self.sl_order], self.model, self.order_vor,
+                                               self.order_bonds)
+        main += self.order_elastic_curvature
+        return main, off
+
     def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
+        """The rod's block (at the rest shape of ``y``'s ``phi``) and the order block; the
+        cross terms are left out (module docstring)."""
+        self.set_rest(y)
         r, c, v = RodSystem.force_jacobian_coo(self._rod, y[:self.n_rod], base,
                                                None if G0 is None else G0[:self.n_rod],
                                                delta, nonlocal_terms)
@@ -166,15 +305,16 @@ class PolymorphSystem(RodSystem):
 
     def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
         """The rod's own stage solver on the first ``n_rod`` unknowns (bit for bit the fixed
-        rod's) and the block's tridiagonal ``I + gamma_h diag(Gamma / v) Hess E``: ``W`` is
-        block diagonal while rod and state are uncoupled."""
+        rod's, at the rest shape of ``y``'s ``phi``) and the block's tridiagonal
+        ``I + gamma_h diag(Gamma / v) Hess E``: ``W`` block diagonal, the cross terms left
+        out (module docstring)."""
         from flagwrap.integrators.linear import make_w
 
+        self.set_rest(y)
         n = self.n_rod
         rod_w = make_w(kind, self._rod, y[:n], base, G0[:n], gamma_h,
                        None if err_scale is None else err_scale[:n], omega)
-        main, off = total_energy_hessian_bands(y[self.sl_order], self.model, self.order_vor,
-                                               self.order_bonds)
+        main, off = self.order_hessian_bands(y)
         m = gamma_h * self.order_mobility
         ab = np.zeros((3, len(main)))
         ab[0, 1:] = m[:-1] * off  # row i, column i + 1
