@@ -969,7 +969,11 @@ class Polymorph:
     (None) ``Gamma = 5 omega / W``, a uniform well relaxing (rate ``2 Gamma W``) ten times per
     radian of the reference motor turn, allowed ``(0, 1e6)`` times that; ``initial``: ``"a"``,
     ``"b"`` (uniform) or ``"wall"`` (the tanh wall (P4) from A at the motor to B at the free
-    end, centred at ``wall_position`` of the contour).
+    end, centred at ``wall_position`` of the contour). ``maxwell_torque`` ``N_M`` [N m]: the
+    twist moment (right-handed positive about the tangent, the rod's convention) at which the
+    two polymorphs are equally stable (P7); default 0 (no intrinsic energy difference: none
+    is published), any finite value: at zero load the wells differ by ``N_M Delta`` per
+    length (``Delta``: B's rest twist density minus A's).
     """
 
     enabled: bool = False
@@ -980,6 +984,7 @@ class Polymorph:
     rate: float | None = None
     initial: str = "a"
     wall_position: float = 0.5
+    maxwell_torque: float = 0.0
 
     INITIAL = ("a", "b", "wall")
     #: most ``rate`` may exceed its default by (a stiff but finite kinetics)
@@ -1008,6 +1013,7 @@ class Polymorph:
         if self.initial not in self.INITIAL:
             raise UserInputError(f"polymorph.initial must be one of {', '.join(self.INITIAL)}, "
                                  f"got {self.initial!r}")
+        _finite("polymorph.maxwell_torque", self.maxwell_torque)
         v = _finite("polymorph.wall_position", self.wall_position)
         if not 0.0 < v < 1.0:
             raise UserInputError(f"polymorph.wall_position must be in (0, 1) (a fraction of "
@@ -1020,6 +1026,10 @@ class Polymorph:
     def wall_width(self) -> float:
         """``w = sqrt(2 K / W)`` [m] of the tanh wall (P4)."""
         return math.sqrt(2.0 * self.stiffness / self.barrier)
+
+    def core_maxwell_torque(self, scales) -> float:
+        """``N_M`` in core units ``[A/L]``."""
+        return self.maxwell_torque / scales.torque
 
     def core(self, scales) -> tuple[float, float, float]:
         """``(W, K, Gamma)`` in core units (``W`` per ``A/L^2``, ``K`` per ``A``, ``Gamma`` per

@@ -67,6 +67,9 @@ class Trajectory:
     #: several flagella: each motor's torque [A/L] then its rate [omega] per frame, (2 n,);
     #: empty for one
     motors: list = field(default_factory=list)
+    #: a polymorphic filament's order parameter per bead per frame (docs/polymorph.md);
+    #: empty without one
+    order: list = field(default_factory=list)
     #: each filament's (first bead, bead count) in ``x``: the system's parts
     filaments: list = field(default_factory=list)
     status: str = "running"
@@ -95,6 +98,8 @@ class Trajectory:
             out["body"] = np.asarray(self.body)
         if self.motors:
             out["motors"] = np.asarray(self.motors)
+        if self.order:
+            out["order"] = np.asarray(self.order)
         return out
 
 
@@ -146,6 +151,8 @@ class Simulation:
                self._strain(info), info.interaction_energy) + hook
         body = getattr(s, "body_record", None)  # a moving body's pose and velocities
         body = None if body is None else body(y, info_in)
+        order = getattr(s, "order_record", None)  # a polymorphic filament's phi per bead
+        order = None if order is None else order(y)
         motors = None
         if s.n_filaments > 1:  # every motor's torque and rate
             motors = np.concatenate([s.motor_torques(info_in, phi, omega, y),
@@ -157,6 +164,8 @@ class Simulation:
             traj.body.append(body)
         if motors is not None:
             traj.motors.append(motors)
+        if order is not None:
+            traj.order.append(order)
 
     def _strain(self, info) -> float:
         ln = self.system.bond_lengths(info.x)

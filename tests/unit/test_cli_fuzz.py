@@ -313,6 +313,7 @@ CONFIGS = [
     ("polymorph", tiny_toml() + POLY.replace("barrier = 1e-12\n", ""), "polymorph.barrier"),
     ("polymorph", tiny_toml() + POLY.replace("enabled = true", "enabled = 'yes'"), "polymorph.enabled"),
     ("polymorph", tiny_toml() + POLY + "wall_position = 1.5\n", "polymorph.wall_position"),
+    ("polymorph", tiny_toml() + POLY + "maxwell_torque = inf\n", "polymorph.maxwell_torque"),
 ]
 
 

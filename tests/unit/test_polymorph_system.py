@@ -229,3 +229,30 @@ def test_rod_at_phi_one_relaxes_to_polymorph_b():
     assert np.abs(pdist(x[1:]) - pdist(s.x0[1:])).max() > 0.1  # it did move
     assert np.abs(s.order(y) - 1.0).max() < 1e-8
     assert info.elastic_energy < 1e-12
+
+
+def test_run_file_and_checkpoint_keep_the_order_parameter(tmp_path):
+    """The order parameters are recorded per frame, written to the run file
+    (``polymorph_order``, with the two polymorphs' names) and kept by a checkpoint: a run
+    resumed from it equals the uninterrupted one bit for bit, order included."""
+    from flagwrap.io.checkpoint import read_checkpoint
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.simulation import simulate
+
+    cfg = _cfg(POLY + "initial = 'wall'\n", ccw=0.2, cw=0.3)
+    ref = simulate(cfg)
+    assert ref.ok and np.asarray(ref.order).shape == (len(ref.t), 21)
+    ck = tmp_path / "c.h5"
+    simulate(cfg, checkpoint_path=ck, checkpoint_every_steps=40)
+    assert "order" in read_checkpoint(ck).records
+    again = simulate(cfg, resume=ck)
+    A, B = ref.arrays(), again.arrays()
+    assert set(A) == set(B) and "order" in A
+    for k in A:
+        assert np.array_equal(A[k], B[k]), k
+    ds = read_run(write_run(ref, tmp_path / "r.nc"))
+    assert np.array_equal(ds["polymorph_order"].values, np.asarray(ref.order))
+    assert ds.attrs["polymorph_a"] == "ecoli_normal" and ds.attrs["polymorph_b"] == "ecoli_semicoiled"
+    # a run without the state has no such variable
+    plain = simulate(_cfg(ccw=0.05, cw=0.05))
+    assert not plain.order and "order" not in plain.arrays()

@@ -46,9 +46,9 @@ _MAGIC = "flagwrap checkpoint"
 RECORD_NAMES = ("t", "x", "theta", "m1", "phi", "omega", "motor_torque", "elastic_energy",
                 "contact_energy", "min_distance", "max_strain", "interaction_energy",
                 "hook_angle", "hook_torque", "hook_twist_torque")
-#: records only some runs have (a free body's pose and velocities; several flagella's motors):
-#: stored when present
-OPTIONAL_RECORD_NAMES = ("body", "motors")
+#: records only some runs have (a free body's pose and velocities; several flagella's motors;
+#: a polymorphic filament's order parameters): stored when present
+OPTIONAL_RECORD_NAMES = ("body", "motors", "order")
 _SCALARS = {"t": float, "t_end": float, "h": float, "next_save": float, "n_steps": int,
             "n_rejected": int, "wall_time": float}
 

@@ -140,7 +140,9 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
         if section == "joint":
             scale.update(hook_bending_modulus=bf, hook_twist_modulus=bf)
         if section == "polymorph":
-            scale.update(stiffness=bf)
+            # the barrier is an energy per length, a force: bending / length^2 (pN um2 / um2
+            # = pN in bacterial units)
+            scale.update(stiffness=bf, barrier=bf / lf**2, maxwell_torque=tf)
         for key, factor in scale.items():
             # numbers only: a bool times a factor would become a float and pass validation
             if _is_number(table.get(key)):

@@ -34,6 +34,8 @@ filament_n_beads       (filament)             its bead count
 tip_positions          (time, filament, xyz)  each flagellum's free end [m]
 motor_torques          (time, filament)       each motor's torque [N m] (sum: motor_torque)
 motor_rates            (time, filament)       each motor's rate [rad/s]
+polymorph_order        (time, bead)           a polymorphic filament's order parameter phi
+                                              (-1: attribute polymorph_a, +1: polymorph_b)
 =====================  =====================  ==============================================
 
 The four ``body_*`` variables are written for a free body (``body.motion = "free"``) only;
@@ -155,6 +157,13 @@ def trajectory_dataset(traj):
                                    {"units": "N m", "long_name": "torque of flagellum k's motor"})
             ds["motor_rates"] = (("time", "filament"), m[:, nf:] * sc.omega,
                                  {"units": "rad/s", "long_name": "rate of flagellum k's motor"})
+    if "order" in a:  # a polymorphic filament's order parameter (docs/polymorph.md)
+        pm = cfg.polymorph
+        ds["polymorph_order"] = (("time", "bead"), a["order"], {
+            "units": "1", "long_name": f"polymorph order parameter: -1 {pm.polymorph_a}, "
+                                       f"+1 {pm.polymorph_b}"})
+        ds.attrs["polymorph_a"] = pm.polymorph_a
+        ds.attrs["polymorph_b"] = pm.polymorph_b
     if "body" in a:  # a free body's pose and velocities (core -> SI)
         b = a["body"]
         ds["body_position"] = (("time", "xyz"), b[:, :3] * L, {"units": "m"})

@@ -171,7 +171,14 @@ class PolymorphSystem(RodSystem):
         W = W if barrier is None else float(barrier)
         K = K if stiffness is None else float(stiffness)
         G = (5.0 / W if G is None else G) if rate is None else float(rate)
-        self.model = PolymorphModel(barrier=W, stiffness=K, delta_twist=0.0)
+        #: its ``Delta`` [1/L]: B's rest twist density minus A's on the transforming
+        #: vertices (0 where nothing transforms); the tilt of (P2) at zero load
+        #: ``-N_M Delta / 2`` is the wells' intrinsic difference, the load's part comes from
+        #: the rod's own twist energy
+        c = (self.mbar_b - self.mbar_a)[self.order_changes]
+        delta = float(c[0] / self.bond) if c.size else 0.0
+        NM = pm.core_maxwell_torque(system.scales) if pm.enabled else 0.0
+        self.model = PolymorphModel(barrier=W, stiffness=K, delta_twist=delta, maxwell_torque=NM)
         self.order_rate = G
         l0 = self.parts[0].rest.l0
         self.order_vor = voronoi_lengths(l0)
@@ -216,6 +223,10 @@ class PolymorphSystem(RodSystem):
     def order(self, y) -> np.ndarray:
         """The order parameters (N,), a view of ``y``."""
         return y[self.sl_order]
+
+    def order_record(self, y) -> np.ndarray:
+        """What a trajectory frame keeps of the block: a copy of the order parameters."""
+        return y[self.sl_order].copy()
 
     # forces and mobility ----------------------------------------------------------------------
     def set_rest(self, y) -> None:
