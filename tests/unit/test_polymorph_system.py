@@ -256,3 +256,59 @@ def test_run_file_and_checkpoint_keep_the_order_parameter(tmp_path):
     # a run without the state has no such variable
     plain = simulate(_cfg(ccw=0.05, cw=0.05))
     assert not plain.order and "order" not in plain.arrays()
+
+
+def test_polymorph_summary_reads_a_known_front(tmp_path):
+    """``polymorph_summary`` on a run file whose order field is replaced by a tanh front
+    leaving the motor at a known speed v (B behind it): B begins at the motor, the front's
+    speed is v (the zero crossing of a tanh two bonds wide, interpolated linearly, is exact
+    to 1e-3 of a bond: the bound 1 %), the final fraction is the front's position over the
+    transforming contour; a run that never enters B says so."""
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.observables.polymorph import polymorph_summary, transforming_vertices
+    from flagwrap.simulation import simulate
+
+    cfg = _cfg(POLY, ccw=0.05, cw=0.5)
+    ds = read_run(write_run(simulate(cfg), tmp_path / "r.nc"))
+    none = polymorph_summary(ds)
+    assert none["start_turns"] is None and none["fraction_b_final"] == 0.0
+    assert polymorph_summary(read_run(write_run(simulate(_cfg(ccw=0.05, cw=0.05)),
+                                                tmp_path / "p.nc"))) is None
+    mask = transforming_vertices(cfg)
+    x0 = ds["position"].values[0]
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x0, axis=0), axis=1))])
+    s0 = s[np.flatnonzero(mask)[0] - 1]
+    t = ds["time"].values
+    L = cfg.filament.length
+    v = 0.6 * L / t[-1]  # crosses 60 % of the filament over the run
+    w = 2 * cfg.filament.bond_length
+    front = 0.15 * L + v * (t - t[0])
+    ds["polymorph_order"].values[:] = np.tanh((front[:, None] - (s[None, :] - s0)) / w)
+    res = polymorph_summary(ds)
+    assert res["starts_at"] == "motor" and res["start_turns"] == ds["turns"].values[0]
+    assert res["front_speed_m_s"] == pytest.approx(v, rel=0.01)
+    sm = s[mask] - s0
+    assert res["fraction_b_final"] == pytest.approx(np.mean(sm < front[-1]), abs=1e-12)
+
+
+def test_cli_analyze_reports_the_polymorph_and_stability_refuses_it(tmp_path, capsys):
+    """``flagwrap analyze`` prints the polymorph line of a polymorph run (and none for a
+    fixed-shape one); ``flagwrap stability`` refuses a polymorph config by name, exit 2,
+    before any work."""
+    from flagwrap.cli.main import main
+
+    body = "[body]\nenabled = true\n"
+    for extra, expect in ((POLY + body, "polymorph ecoli_normal -> ecoli_semicoiled"),
+                          (body, None)):
+        cfg = tmp_path / "c.toml"
+        cfg.write_text(tiny_toml(ccw=0.1, cw=0.3) + extra)
+        out = tmp_path / "r.nc"
+        assert main(["run", str(cfg), "-o", str(out), "--quiet"]) == 0
+        capsys.readouterr()
+        assert main(["analyze", str(out), "--no-store"]) == 0
+        text = capsys.readouterr().out
+        assert (expect in text) if expect else ("polymorph" not in text)
+    cfg.write_text(tiny_toml() + POLY + body)
+    assert main(["stability", str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert "polymorph.enabled" in err and err.count("\n") == 1

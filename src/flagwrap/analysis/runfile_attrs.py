@@ -206,6 +206,11 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
 
     wall = wall_summary(ds)
     res["wall"] = None if wall is None else {k: v for k, v in wall.items() if k != "gap_series"}
+    from flagwrap.observables.polymorph import polymorph_summary
+
+    poly = polymorph_summary(ds)
+    res["polymorph"] = (None if poly is None else
+                        {k: v for k, v in poly.items() if k != "fraction_series"})
     res["params"] = a.params()
     res["path"] = str(path)
     res["run_status"] = str(ds.attrs.get("status", ""))

@@ -143,6 +143,8 @@ def run(args) -> int:
             print(f"  wall: closest bead surface {w['gap_min']:+.3g} m from it (at turn "
                   f"{w['gap_min_turns']:.2f}), {w['gap_final']:+.3g} m at the end; free end "
                   f"{w['tip_height_final']:.3g} m above it")
+        if res.get("polymorph"):
+            print("  " + polymorph_line(res["polymorph"]))
         for ph in res["swimming"]:  # a free swimmer, phase by phase (second half of each)
             what = "last turns" if ph["direction"] == "final" else f"{ph['direction']} phase"
             print(f"  swimming, {what} ({ph['t0']:.3g}-{ph['t1']:.3g} s): "
@@ -152,6 +154,18 @@ def run(args) -> int:
         print(f"  not stored (--no-store): {path} unchanged" if args.no_write
               else f"  {stored_line(path)}")
     return 0
+
+
+def polymorph_line(p: dict) -> str:
+    """The polymorph state's one line (:func:`flagwrap.observables.polymorph.polymorph_summary`)."""
+    head = (f"polymorph {p['polymorph_a']} -> {p['polymorph_b']}: fraction in "
+            f"{p['polymorph_b']} {p['fraction_b_final']:.3f} at the end (max {p['fraction_b_max']:.3f})")
+    if p["start_turns"] is None:
+        return head + f"; never entered {p['polymorph_b']}"
+    front = ("no moving front" if p["front_speed_m_s"] is None
+             else f"front {p['front_speed_m_s'] * 1e6:+.3g} um/s")
+    return (head + f"; began at turn {p['start_turns']:.2f} ({p['start_time_s']:.3g} s), "
+            f"{p['start_position_m'] * 1e6:.3g} um from the motor (the {p['starts_at']}), {front}")
 
 
 def stored_line(path) -> str:

@@ -157,12 +157,14 @@ def run(args) -> int:
     import sys
 
     from flagwrap.io.config import load_config_or_case
-    from flagwrap.stability.threshold import critical_from_config, resolve_m_max
+    from flagwrap.stability.threshold import (critical_from_config, refuse_polymorph,
+                                              resolve_m_max)
 
     check_options(args)
     if getattr(args, "sweep", False):
         return _run_sweep(args)
     cfg = load_config_or_case(args.config)
+    refuse_polymorph(cfg)
     if args.no_hi:
         cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
     if _wants_far(args):

@@ -247,11 +247,24 @@ def resolve_m_max(config, m_start: float, m_max: float | None) -> float:
     return m
 
 
+def refuse_polymorph(config) -> None:
+    """A one-line :class:`UserInputError` for a polymorphic filament: its order parameters
+    are not unknowns of the turning frame yet (docs/polymorph.md)."""
+    if config.polymorph.enabled:
+        raise UserInputError(
+            "polymorph.enabled = true is not available to flagwrap stability (the turning frame "
+            "does not carry the order parameter yet); run it in the time domain (flagwrap run, "
+            "or studies/polymorph_switch.py for the switching torque), or set polymorph.enabled "
+            "= false for the fixed shape of polymorph_a")
+
+
 def make_frame(config, omega: float):
     """The turning frame of ``config``'s system at ``omega``: a free swimmer's
     (:class:`~flagwrap.system.swimmer.SwimmerFrame`) or the rig's
     (:class:`~flagwrap.system.rotating.RotatingFrame`; a fixed no-slip body's blob shell held
-    at one angle, ``blob_body``)."""
+    at one angle, ``blob_body``). A polymorphic filament is refused by name: its order
+    parameters are not unknowns of the turning frame yet (docs/polymorph.md)."""
+    refuse_polymorph(config)
     if config.body.free:
         if config.walls:
             raise UserInputError(
