@@ -312,3 +312,28 @@ def test_cli_analyze_reports_the_polymorph_and_stability_refuses_it(tmp_path, ca
     assert main(["stability", str(cfg)]) == 2
     err = capsys.readouterr().err
     assert "polymorph.enabled" in err and err.count("\n") == 1
+
+
+def test_tube_is_coloured_by_polymorph():
+    """``polymorph_rgb``: phi = -1 gives the tube's colour, +1 the B colour, a wall in the
+    middle mixes them in order along the tube; ``Renderer.polygons`` with ``order`` colours
+    the faces per segment (both colours present for a half-and-half filament)."""
+    from flagwrap.plotting.render import (CAMERAS, POLYMORPH_B_RGB, TUBE_RGB, Renderer, Scene,
+                                          polymorph_rgb)
+
+    n = 11
+    a = polymorph_rgb(-np.ones(n), 30, 4)
+    b = polymorph_rgb(np.ones(n), 30, 4)
+    assert np.allclose(a, TUBE_RGB) and np.allclose(b, POLYMORPH_B_RGB) and a.shape == (120, 3)
+    ramp = polymorph_rgb(np.linspace(-1, 1, n), 30, 1)
+    w = (ramp - TUBE_RGB) @ (POLYMORPH_B_RGB - TUBE_RGB) / np.sum((POLYMORPH_B_RGB - TUBE_RGB) ** 2)
+    assert np.all(np.diff(w) > 0) and w[0] < 0.05 and w[-1] > 0.95
+    x = np.column_stack([np.zeros(n), np.zeros(n), -np.linspace(0, 1, n)])
+    x[:, 0] = 0.05 * np.sin(np.linspace(0, 6, n))
+    rend = Renderer(Scene(tube_radius=0.01, body_radius=0.0, body_length=0.0, length=1.0))
+    order = np.where(np.arange(n) < n // 2, 1.0, -1.0)
+    _, rgba = rend.polygons(x, CAMERAS[0], order=order)
+    plain = rend.polygons(x, CAMERAS[0])[1]
+    hue = rgba[:, 0] - rgba[:, 2]  # orange: red > blue; blue: blue > red
+    assert (hue > 0).any() and (hue < 0).any()
+    assert ((plain[:, 0] - plain[:, 2]) < 0).all()

@@ -131,6 +131,8 @@ class MovieFrames:
         self.times = movie_times(self.time, self.fps, speed)
         self.turns = np.interp(self.times, self.time, ds["turns"].values)
         self.X = ds["position"].values
+        #: a polymorphic filament's order parameter per frame and bead (coloured by form)
+        self.order = ds["polymorph_order"].values if "polymorph_order" in ds.variables else None
         self.scene = scene_of(ds)
         self.renderer = Renderer(self.scene, **(renderer_kwargs or {}))
         self.poses = body_poses(ds)  # a free swimmer's body, drawn where it is
@@ -214,8 +216,11 @@ class MovieFrames:
         if self.poses is not None:  # the body's position interpolated as the beads are
             Xb = np.array([np.interp(tq, self.time, self.poses[0][:, c]) for c in range(3)])
             pose = (Xb, self.poses[1][i])
+        order = None
+        if self.order is not None:  # interpolated in time as the beads are
+            order = _interp_frames(self.time, self.order, np.array([tq]))[0][0]
         for ax, cam in zip(self.ax_views, CAMERAS):
-            self.renderer.draw(ax, x, cam, pose)
+            self.renderer.draw(ax, x, cam, pose, order)
         turn = self.turns[k]
         self._clock.set_text(f"t/T = {turn:6.2f}")
         if om < 0:

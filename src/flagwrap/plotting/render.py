@@ -266,7 +266,24 @@ TUBE_RGB = np.array([0.20, 0.40, 0.75])
 #: the tubes of several flagella (the first is the single filament's colour)
 TUBE_PALETTE = (TUBE_RGB, np.array([0.80, 0.35, 0.15]), np.array([0.20, 0.60, 0.30]),
                 np.array([0.55, 0.30, 0.65]), np.array([0.75, 0.60, 0.10]))
+#: a polymorphic filament (``polymorph_order``): polymorph A (phi = -1) in the tube's blue,
+#: B (phi = +1) in orange, mixed linearly between
+POLYMORPH_B_RGB = np.array([0.90, 0.45, 0.10])
 BODY_RGB = np.array([0.62, 0.64, 0.66])
+
+
+def polymorph_rgb(order, n_segments: int, n_faces_per_ring: int, a_rgb=TUBE_RGB,
+                  b_rgb=POLYMORPH_B_RGB) -> np.ndarray:
+    """Face colours (Q, 3) of one tube from the order parameter per bead (N,): each of the
+    ``n_segments`` ring segments of the resampled centreline (evenly spread over the bonds)
+    takes ``phi`` interpolated at its middle, clipped to [-1, 1], mixed from ``a_rgb`` to
+    ``b_rgb``."""
+    order = np.asarray(order, float)
+    n = len(order)
+    u = (np.arange(n_segments) + 0.5) * (n - 1) / n_segments  # segment middles, in beads
+    w = 0.5 * (np.clip(np.interp(u, np.arange(n), order), -1.0, 1.0) + 1.0)
+    rgb = (1.0 - w)[:, None] * a_rgb[None, :] + w[:, None] * b_rgb[None, :]
+    return np.repeat(rgb, n_faces_per_ring, axis=0)
 BODY_ALPHA = 0.4
 
 
@@ -274,7 +291,9 @@ def _shade(normals, camera, rgb, ambient=0.35, diffuse=0.65):
     light = np.asarray(camera.toward) + 0.5 * np.array([0, 0, 1.0]) - 0.4 * np.asarray(camera.right)
     light /= np.linalg.norm(light)
     lam = np.clip(normals @ light, 0.0, None)
-    return np.clip((ambient + diffuse * lam)[:, None] * rgb[None, :], 0, 1)
+    rgb = np.asarray(rgb)
+    return np.clip((ambient + diffuse * lam)[:, None] * (rgb if rgb.ndim == 2 else rgb[None, :]),
+                   0, 1)
 
 
 class Renderer:
@@ -312,7 +331,7 @@ class Renderer:
         self._collections = {}
 
     # geometry ------------------------------------------------------------------------------
-    def polygons(self, x: np.ndarray, camera: Camera, pose=None):
+    def polygons(self, x: np.ndarray, camera: Camera, pose=None, order=None):
         """Depth-sorted 2D polygons and RGBA colours of one frame seen by ``camera``.
 
         Parameters
@@ -320,6 +339,8 @@ class Renderer:
         x : (N, 3) bead positions [m]
         pose : ``(X, R)`` of a moving body (its reference point [m] and rotation, body to
             lab), or ``None`` for the fixed body at the origin
+        order : (N,) a polymorphic filament's order parameter per bead: the tube coloured by
+            polymorph (:func:`polymorph_rgb`), or ``None`` (one colour)
 
         Returns
         -------
@@ -333,6 +354,14 @@ class Renderer:
             quads, qn, caps, cn = tube_faces(x[sl], self.scene.tube_radius, self.sides,
                                              self.subdivide)
             rgb = self.tube_rgb if len(chains) == 1 else TUBE_PALETTE[k % len(TUBE_PALETTE)]
+            if order is not None:
+                o = np.asarray(order)[sl]
+                groups.append((quads, qn, polymorph_rgb(o, len(quads) // self.sides,
+                                                        self.sides, a_rgb=rgb), 1.0))
+                ends = np.clip(o[[0, -1]], -1.0, 1.0) * 0.5 + 0.5
+                cap_rgb = (1 - ends)[:, None] * rgb + ends[:, None] * POLYMORPH_B_RGB
+                groups.append((caps, cn, cap_rgb, 1.0))
+                continue
             groups.append((quads, qn, rgb, 1.0))
             groups.append((caps, cn, rgb, 1.0))
         if len(self._body):
@@ -345,6 +374,8 @@ class Renderer:
         for P, n, rgb, alpha in groups:
             front = n @ toward > 0.0
             P, n = P[front], n[front]
+            if np.ndim(rgb) == 2:  # a colour per face (a polymorphic filament)
+                rgb = rgb[front]
             if not len(P):
                 continue
             u, v, d = camera.project(P)
@@ -361,12 +392,13 @@ class Renderer:
         self._linewidths = np.concatenate(lw)[order]
         return [polys[i] for i in order], np.concatenate(rgba)[order]
 
-    def draw(self, ax, x: np.ndarray, camera: Camera, pose=None):
+    def draw(self, ax, x: np.ndarray, camera: Camera, pose=None, order=None):
         """Draw the frame ``x`` (N, 3) [m] into ``ax`` as seen by ``camera`` (a moving body at
-        ``pose``, :meth:`polygons`); returns the collection."""
+        ``pose``, a polymorphic filament's ``order``: :meth:`polygons`); returns the
+        collection."""
         from matplotlib.collections import PolyCollection
 
-        polys, rgba = self.polygons(x, camera, pose)
+        polys, rgba = self.polygons(x, camera, pose, order)
         coll = self._collections.get(id(ax))
         if coll is None:
             coll = PolyCollection(polys, facecolors=rgba, edgecolors=rgba,

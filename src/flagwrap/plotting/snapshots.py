@@ -93,6 +93,8 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     times = default_times(ds, n) if times is None else np.atleast_1d(np.asarray(times, float))
     idx = frame_indices(ds, times)
     X = ds["position"].values
+    # a polymorphic filament: coloured by form (render.polymorph_rgb)
+    order = ds["polymorph_order"].values if "polymorph_order" in ds.variables else None
     turns = ds["turns"].values
     om = ds["omega"].values
     scene = scene_of(ds)
@@ -108,7 +110,8 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     for j, i in enumerate(idx):
         for r, cam in enumerate(CAMERAS):
             ax = axes[r, j]
-            rend.draw(ax, X[i], cam, None if poses is None else (poses[0][i], poses[1][i]))
+            rend.draw(ax, X[i], cam, None if poses is None else (poses[0][i], poses[1][i]),
+                      None if order is None else order[i])
             sense = "CW" if om[i] < 0 else ("CCW" if om[i] > 0 else "stop")
             style_view(ax, ulim, zlim,
                        title=f"$t/T$ = {turns[i]:.2f} ({sense})" if r == 0 else None,
@@ -121,6 +124,9 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
     if title is None:
         hi = "with HI" if ds.attrs.get("hydrodynamics", 1) else "without HI"
         title = f"{ds.attrs.get('title', 'flagwrap run')}: M = {float(ds.attrs['machin']):.4g}, {hi}"
+        if order is not None:
+            title += (f"; blue: {ds.attrs.get('polymorph_a', 'polymorph A')}, orange: "
+                      f"{ds.attrs.get('polymorph_b', 'polymorph B')}")
     # wrapped to the figure's width (~13 characters per inch at 8 pt): a one-column strip is
     # narrower than its title
     import textwrap
