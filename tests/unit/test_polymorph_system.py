@@ -337,3 +337,31 @@ def test_tube_is_coloured_by_polymorph():
     hue = rgba[:, 0] - rgba[:, 2]  # orange: red > blue; blue: blue > red
     assert (hue > 0).any() and (hue < 0).any()
     assert ((plain[:, 0] - plain[:, 2]) < 0).all()
+
+
+def test_movie_and_snapshots_of_a_polymorph_run(tmp_path):
+    """A polymorph run's movie frames and snapshot strip render with the tube coloured by
+    form: with B over the first half of the filament, the frame has orange pixels, which the
+    same run drawn without the order (one colour) has not."""
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.plotting.movies import MovieFrames
+    from flagwrap.plotting.snapshots import write_snapshots
+    from flagwrap.simulation import simulate
+
+    tr = simulate(_cfg(POLY + "initial = 'wall'\n", ccw=0.05, cw=0.1))
+    ds = read_run(write_run(tr, tmp_path / "r.nc"))
+    n = ds.sizes["bead"]
+    ds["polymorph_order"].values[:] = np.where(np.arange(n) < n // 2, 1.0, -1.0)
+    frames = MovieFrames(ds, fps=10, size=(320, 192))
+    assert frames.order is not None
+    img = frames.render(0).astype(int)
+    frames.order = None
+    plain = frames.render(0).astype(int)
+
+    def orange(im):
+        r, g, b = im[..., 0], im[..., 1], im[..., 2]
+        return int(np.sum((r > b + 60) & (r > 120) & (g < r)))
+
+    assert orange(img) > 10 and orange(img) > 5 * orange(plain)
+    paths = write_snapshots(ds, tmp_path / "s.png", formats=("png",), dpi=60, n=2)
+    assert paths and all(p.stat().st_size > 0 for p in paths)
