@@ -365,3 +365,31 @@ def test_movie_and_snapshots_of_a_polymorph_run(tmp_path):
     assert orange(img) > 10 and orange(img) > 5 * orange(plain)
     paths = write_snapshots(ds, tmp_path / "s.png", formats=("png",), dpi=60, n=2)
     assert paths and all(p.stat().st_size > 0 for p in paths)
+
+
+def test_vtk_export_uses_each_frames_polymorph_rest(tmp_path):
+    """ParaView export of a polymorph run: the rebuilt elastic energy at each frame's order
+    parameters equals the simulator's stored one (the oracle of tests/unit/test_vtk.py), which
+    A's fixed rest does not; each frame's .vtp carries ``polymorph_order``."""
+    import xml.etree.ElementTree as ET
+
+    from flagwrap.io.runfile import config_of, read_run, write_run
+    from flagwrap.io.vtk import ElasticForces, export_vtk
+    from flagwrap.simulation import simulate
+
+    ds = read_run(write_run(simulate(_cfg(POLY + "initial = 'wall'\n", ccw=0.1, cw=0.2)),
+                            tmp_path / "r.nc"))
+    ef = ElasticForces(config_of(ds))
+    X, M, O = ds["position"].values, ds["director"].values, ds["polymorph_order"].values
+    stored = ds["elastic_energy"].values
+    E = []
+    for x, m, o in zip(X, M, O):
+        ef.set_order(o)
+        E.append(ef(x, m)[0])
+    np.testing.assert_allclose(E, stored, rtol=1e-8, atol=1e-12 * stored.max())
+    ef.set_order(-np.ones(O.shape[1]))  # A's rest: not the run's energy
+    assert abs(ef(X[-1], M[-1])[0] - stored[-1]) > 1e-3 * stored[-1]
+    pvd = export_vtk(ds, tmp_path / "vtk", stride=5)
+    vtp = sorted(pvd.parent.glob("filament_*.vtp"))[-1]
+    names = [a.get("Name") for a in ET.parse(vtp).getroot().iter("DataArray")]
+    assert "polymorph_order" in names and "elastic_force" in names

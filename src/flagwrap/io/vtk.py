@@ -26,6 +26,9 @@ handedness             1          sign of the discrete torsion, ``sign(e_{i-1} .
                                   -1 left-handed, 0 straight/planar
 elastic_force          N          ``-dE/dx_i`` of the Kirchhoff energy (bending, twisting,
                                   stretching) rebuilt from the positions and directors (see below)
+polymorph_order        1          a polymorphic filament's order parameter (-1: polymorph A, +1: B);
+                                  its rest curvature and twist, and so ``excess_twist_rate`` and
+                                  ``elastic_force``, are those of this frame's state
 =====================  =========  ==================================================================
 
 The elastic force is recomputed with the simulator's own energy: reference frames by parallel
@@ -134,9 +137,29 @@ class ElasticForces:
         from flagwrap.system.parts import build_parts
 
         self.parts = build_parts(config)
+        #: a polymorphic filament's two rest shapes (flagwrap.system.polymorph.rest_pair):
+        #: :meth:`set_order` moves the rest between them as the simulator does
+        self._pair = None
+        if config.polymorph.enabled:
+            import dataclasses
+
+            from flagwrap.system.polymorph import rest_pair
+
+            p = self.parts[0]
+            p.rest = dataclasses.replace(p.rest, kbar=p.rest.kbar.copy(), mbar=p.rest.mbar.copy())
+            self._pair = rest_pair(p, config)[:4]
         self.L = config.scales.length
         self.force_scale = config.scales.force
         self.energy_scale = config.scales.energy
+
+    def set_order(self, order) -> None:
+        """A polymorphic filament's rest at its order parameters ``order`` (N,), one frame's
+        (``a + (phi + 1)/2 (b - a)``, as the simulator's ``set_rest``)."""
+        ka, kb, ma, mb = self._pair
+        t = 0.5 * (np.asarray(order, float) + 1.0)
+        rest = self.parts[0].rest
+        rest.kbar[:] = ka + t[:, None] * (kb - ka)
+        rest.mbar[:] = ma + t * (mb - ma)
 
     def rest_twist(self, filament: int = 0) -> np.ndarray:
         """Rest twist ``m_i^0`` [rad] per bead (N,) of flagellum ``filament``."""
@@ -307,9 +330,14 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
     idx = range(0, len(turns), stride)
     width = max(4, len(str(len(turns) - 1)))
     line = [np.arange(sl.start, sl.stop) for sl in slices]  # one polyline per flagellum
+    order = ds["polymorph_order"].values if "polymorph_order" in ds.variables else None
     for i in idx:
         name = f"filament_{i:0{width}d}.vtp"
+        if order is not None:  # the rest of this frame's polymorph state (one filament)
+            elastic.set_order(order[i])
         pdata = frames_point_data(X[i], M1[i], slices, forces, rest)
+        if order is not None:
+            pdata["polymorph_order"] = np.asarray(order[i], float)
         cdata = {"turns": np.array([turns[i]]), "time": np.array([secs[i]])}
         _write(d / name, polydata_xml(X[i], lines=line, point_data=pdata, cell_data=cdata))
         entries.append((float(tvals[i]), 0, name))
