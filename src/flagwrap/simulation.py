@@ -518,7 +518,12 @@ def make_system(config):
     if config.body.free:
         from flagwrap.system.swimmer import make_swimmer
 
-        return make_swimmer(config)
+        system = make_swimmer(config)
+        if config.polymorph.enabled:
+            from flagwrap.system.polymorph import PolymorphSystem
+
+            system = PolymorphSystem(system)
+        return system
     system = RodSystem(config)
     if config.numerics.frame == "rotating":
         from flagwrap.system.rotating import RotatingSystem

@@ -6,7 +6,7 @@ and bad [polymorph] input is one line naming the key."""
 import numpy as np
 import pytest
 
-from conftest import tiny_toml
+from conftest import system_kinds, tiny_toml
 from flagwrap.errors import UserInputError
 from flagwrap.io.config import config_from_dict, tomllib
 
@@ -36,20 +36,59 @@ def test_polymorph_config_round_trips():
     assert config_from_dict(tomllib.loads(config_to_toml(cfg))) == cfg
 
 
-def test_one_state_filament_steps_bit_for_bit_as_the_fixed_rod():
+KINDS = system_kinds()
+RUNS_ON = ("lab", "krylov", "fixed no-slip body", "free cell")
+REFUSED = {"turning frame": "numerics.frame", "two flagella on a free cell": "[[flagellum]]"}
+
+
+def _kind_cfg(kind, extra="", **kw):
+    num, tables = KINDS[kind]
+    return config_from_dict(tomllib.loads(
+        tiny_toml(**kw).replace("[numerics]\n", "[numerics]\n" + num) + tables + extra))
+
+
+@pytest.mark.parametrize("kind", RUNS_ON)
+def test_one_state_filament_steps_bit_for_bit_as_the_fixed_rod(kind):
     """Both polymorphs the same and phi uniform in a well: the order block's force is exactly
-    zero, and the rod's unknowns take the fixed rod's steps to the last bit."""
+    zero, and the system's own unknowns (a free cell's pose included) take the fixed rod's
+    steps to the last bit, on every kind of system the polymorph runs on."""
     from flagwrap.simulation import make_system, simulate
 
-    plain = _cfg(ccw=0.1, cw=0.05)
-    one = _cfg(POLY + "polymorph_b = 'ecoli_normal'\n", ccw=0.1, cw=0.05)
-    assert type(make_system(one)).__name__ == "PolymorphSystem"
+    plain = _kind_cfg(kind, ccw=0.1, cw=0.05)
+    one = _kind_cfg(kind, POLY + "polymorph_b = 'ecoli_normal'\n", ccw=0.1, cw=0.05)
+    assert type(make_system(one)).__name__ == ("PolymorphSwimmer" if kind == "free cell"
+                                               else "PolymorphSystem")
     a, b = simulate(plain), simulate(one)
     assert a.status == b.status == "completed"
     assert (a.n_steps, a.n_rejected) == (b.n_steps, b.n_rejected)
-    assert np.array_equal(np.asarray(a.t), np.asarray(b.t))
-    assert np.array_equal(np.asarray(a.x), np.asarray(b.x))
-    assert np.array_equal(np.asarray(a.theta), np.asarray(b.theta))
+    A, B = a.arrays(), b.arrays()
+    assert set(B) - set(A) == {"order"}
+    for k in A:
+        assert np.array_equal(A[k], B[k]), k
+    assert np.all(B["order"] == -1.0)
+
+
+@pytest.mark.parametrize("kind", RUNS_ON)
+def test_turning_moves_the_order_on_every_kind(kind):
+    """Normal -> semicoiled on each kind: the run completes, records the order per frame,
+    and the loaded rod moves phi off -1 (by ~1 % here: the test rig's helix is far below
+    its switching load; which way depends on the bending and twist it carries, and on this
+    rig CCW raises it; the E. coli test below checks the switch itself)."""
+    from flagwrap.simulation import simulate
+
+    tr = simulate(_kind_cfg(kind, POLY, ccw=0.3, cw=0.3))
+    assert tr.ok, tr.message
+    o = np.asarray(tr.order)
+    assert o.shape == (len(tr.t), 21)
+    assert np.abs(o[-1] + 1.0).max() > 1e-3 and np.all(np.abs(o) < 1.1)
+
+
+@pytest.mark.parametrize("kind", sorted(REFUSED))
+def test_polymorph_is_refused_by_name_on_the_other_kinds(kind):
+    with pytest.raises(UserInputError) as exc:
+        _kind_cfg(kind, POLY)
+    msg = str(exc.value)
+    assert "polymorph.enabled" in msg and REFUSED[kind].strip("[]") in msg and "\n" not in msg
 
 
 def _relax(system, t_end, h=0.02):
@@ -393,3 +432,34 @@ def test_vtk_export_uses_each_frames_polymorph_rest(tmp_path):
     vtp = sorted(pvd.parent.glob("filament_*.vtp"))[-1]
     names = [a.get("Name") for a in ET.parse(vtp).getroot().iter("DataArray")]
     assert "polymorph_order" in names and "elastic_force" in names
+
+
+@pytest.mark.parametrize("direction, switches", [("cw", True), ("ccw", False)])
+def test_ecoli_cw_torque_switches_normal_to_semicoiled_from_the_motor(direction, switches):
+    """The E. coli case (31 beads, a speed motor at 500 Hz for 3 turns): CW turns the
+    filament semicoiled, starting at the motor's end (the first B vertex in the filament's
+    first third), CCW never does (docs/polymorph.md, "The model's switching torque":
+    the switch lies between 350 and 400 Hz CW at this resolution)."""
+    import dataclasses
+
+    from flagwrap.cases import get_case
+    from flagwrap.params import Phase
+    from flagwrap.simulation import Simulation
+
+    base = get_case("ecoli_polymorph")
+    cfg = base.replace(
+        filament=dataclasses.replace(base.filament, n_beads=31, pitch_angle_deg=None, turns=None),
+        motor=dataclasses.replace(base.motor, kind="speed", frequency=500.0, machin=None,
+                                  stall_torque=None, zero_load_speed=None,
+                                  protocol=(Phase(direction, 3.0),)))
+    sim = Simulation(cfg)
+    tr = sim.run()
+    assert tr.ok, tr.message
+    o = np.asarray(tr.order)[:, sim.system.order_changes]
+    inb = o > 0.0
+    assert inb.any() == switches
+    if switches:
+        k = np.flatnonzero(inb.any(axis=1))[0]
+        first = np.flatnonzero(inb[k])
+        assert first.min() < o.shape[1] / 3
+        assert 0.1 < inb[-1].mean() < 0.9  # a front that stops: B at the motor, A beyond

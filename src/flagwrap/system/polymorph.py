@@ -133,17 +133,36 @@ def rest_pair(part, config):
 
 
 class PolymorphSystem(RodSystem):
-    """``system`` (one filament, lab frame) with the order block (module docstring), from
-    ``system.config.polymorph`` or the core-unit ``barrier``, ``stiffness``, ``rate`` and
-    initial profile ``order0`` (N,) given here."""
+    """``system`` (one filament: the lab-frame rig or a free swimmer) with the order block
+    (module docstring), from ``system.config.polymorph`` or the core-unit ``barrier``,
+    ``stiffness``, ``rate`` and initial profile ``order0`` (N,) given here.
+
+    The block follows all of ``system``'s unknowns (``y = [system's y | order]``). Its
+    methods add the block to ``system``'s own (``super()``): for a free swimmer
+    (:class:`~flagwrap.system.swimmer.SwimmerSystem`) the instance is a
+    :class:`PolymorphSwimmer`, whose next class is the swimmer's. ``_rod`` is a view of
+    ``system`` over its own unknowns, the stage solvers' system."""
+
+    def __new__(cls, system, *args, **kwargs):
+        from flagwrap.system.swimmer import SwimmerSystem
+
+        if isinstance(system, SwimmerSystem) and not issubclass(cls, SwimmerSystem):
+            cls = PolymorphSwimmer
+        return object.__new__(cls)
 
     def __init__(self, system, barrier=None, stiffness=None, rate=None, order0=None):
-        if len(system.parts) != 1 or system.ny != system.n_rod:
-            raise ValueError("PolymorphSystem: one filament without a free body")
+        if len(system.parts) != 1 or isinstance(system, PolymorphSystem):
+            raise ValueError("PolymorphSystem: one filament, without an order block already")
+        from flagwrap.system.swimmer import SwimmerSystem
+
+        inner = SwimmerSystem if isinstance(self, SwimmerSystem) else RodSystem
+        if type(system) is not inner:
+            raise ValueError(f"PolymorphSystem: a {type(system).__name__} is not supported "
+                             "(the lab-frame rig or a free swimmer)")
         import copy
         import dataclasses
 
-        rod = object.__new__(RodSystem)  # the rod's own view: its stage solvers see n_rod
+        rod = object.__new__(type(system))  # the system's own view over its own unknowns
         rod.__dict__.update(system.__dict__)
         self.__dict__.update(system.__dict__)  # the same buffers: a view
         self._rod = rod
@@ -191,7 +210,8 @@ class PolymorphSystem(RodSystem):
         #: the integrators combine stage increments of the rod's unknowns apart from the
         #: block's (:func:`flagwrap.integrators.rosenbrock._combine`): with the block
         #: uncoupled, the rod then steps bit for bit as the fixed-shape rod
-        self.stage_split = self.n_rod
+        self.stage_split = rod.ny
+        self.n_inner = rod.ny
         #: the block's mobility ``Gamma / v_i`` (P8)
         self.order_mobility = G / self.order_vor
         if order0 is None:
@@ -212,11 +232,11 @@ class PolymorphSystem(RodSystem):
         return wall_profile(s, pm.wall_position * s[-1], self.model.wall_width)
 
     # state ---------------------------------------------------------------------------------
-    def pack(self, x, theta, phi, order=None) -> np.ndarray:
-        """``y`` from the rod's ``x``, ``theta``, motor angle and the order parameters
-        (default: the initial profile)."""
+    def pack(self, x, theta, phi, *pose, order=None, **kw) -> np.ndarray:
+        """``y`` from the system's own packing (the rod's ``x``, ``theta``, motor angle, a
+        swimmer's pose) and the order parameters (default: the initial profile)."""
         y = np.empty(self.ny)
-        y[:self.n_rod] = RodSystem.pack(self._rod, x, theta, phi)
+        y[:self.n_inner] = self._rod.pack(x, theta, phi, *pose, **kw)
         y[self.sl_order] = self.order0 if order is None else order
         return y
 
@@ -259,7 +279,7 @@ class PolymorphSystem(RodSystem):
         """The rod's forces at the rest shape of ``y``'s ``phi`` and the block's
         ``G = -dE/dphi`` of (P3) plus the rod's elastic energy."""
         self.set_rest(y)
-        info = RodSystem.forces(self, y, base)
+        info = super().forces(y, base)
         phi = y[self.sl_order]
         info.G[self.sl_order] = -total_energy_grad(phi, self.model, 0.0, self.order_vor,
                                                    self.order_bonds)
@@ -269,19 +289,21 @@ class PolymorphSystem(RodSystem):
         return info
 
     def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
-        out = RodSystem.apply_mobility(self, y, G, single)
+        out = super().apply_mobility(y, G, single)
         np.multiply(self.order_mobility, G[self.sl_order], out=out[self.sl_order])
         return out
 
     def local_mobility_diagonal(self) -> np.ndarray:
         d = np.zeros(self.ny)
-        d[:self.n_rod] = RodSystem.local_mobility_diagonal(self._rod)
+        inner = self._rod.local_mobility_diagonal()
+        d[:len(inner)] = inner
         d[self.sl_order] = self.order_mobility
         return d
 
     def mobility_matrix(self, y) -> np.ndarray:
         Mob = np.zeros((self.ny, self.ny))
-        Mob[:self.n_rod, :self.n_rod] = RodSystem.mobility_matrix(self._rod, y[:self.n_rod])
+        inner = self._rod.mobility_matrix(y[:self.n_inner])
+        Mob[:len(inner), :len(inner)] = inner
         i = np.arange(self.sl_order.start, self.sl_order.stop)
         Mob[i, i] = self.order_mobility
         return Mob
@@ -308,21 +330,21 @@ class PolymorphSystem(RodSystem):
         """The rod's block (at the rest shape of ``y``'s ``phi``) and the order block; the
         cross terms are left out (module docstring)."""
         self.set_rest(y)
-        r, c, v = RodSystem.force_jacobian_coo(self._rod, y[:self.n_rod], base,
+        r, c, v = self._rod.force_jacobian_coo(y[:self.n_rod], base,
                                                None if G0 is None else G0[:self.n_rod],
                                                delta, nonlocal_terms)
         ro, co, vo = self.order_jacobian_coo(y)
         return np.concatenate([r, ro]), np.concatenate([c, co]), np.concatenate([v, vo])
 
     def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
-        """The rod's own stage solver on the first ``n_rod`` unknowns (bit for bit the fixed
+        """The system's own stage solver on its own unknowns (bit for bit the fixed
         rod's, at the rest shape of ``y``'s ``phi``) and the block's tridiagonal
         ``I + gamma_h diag(Gamma / v) Hess E``: ``W`` block diagonal, the cross terms left
         out (module docstring)."""
         from flagwrap.integrators.linear import make_w
 
         self.set_rest(y)
-        n = self.n_rod
+        n = self.n_inner
         rod_w = make_w(kind, self._rod, y[:n], base, G0[:n], gamma_h,
                        None if err_scale is None else err_scale[:n], omega)
         main, off = self.order_hessian_bands(y)
@@ -345,3 +367,28 @@ class _BlockW:
         out[:self.n] = self.rod_w.solve(rhs[:self.n])
         out[self.n:] = sla.solve_banded((1, 1), self.ab, rhs[self.n:], check_finite=False)
         return out
+
+
+def _swimmer_class():
+    from flagwrap.system.swimmer import SwimmerSystem
+
+    class PolymorphSwimmer(PolymorphSystem, SwimmerSystem):
+        """A free swimmer (:class:`~flagwrap.system.swimmer.SwimmerSystem`) whose filament
+        carries the order block: ``y = [filament | pose | order]``; the swimmer's stage
+        solver on its own unknowns and the block's tridiagonal solve (:meth:`make_w`).
+
+        The swimmer keeps the last geometry and the last pose's body solve in caches whose
+        arrays are shared buffers (``M_fb`` is built into one): both views must read one
+        cache, else one view's rebuild overwrites what the other's cache still claims.
+        Both go through the stage solver's view ``_rod``."""
+
+        def _geometry(self, y):
+            return self._rod._geometry(y[:self.n_inner])
+
+        def _body(self, y):
+            return self._rod._body(y[:self.n_inner])
+
+    return PolymorphSwimmer
+
+
+PolymorphSwimmer = _swimmer_class()
