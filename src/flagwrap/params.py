@@ -974,6 +974,15 @@ class Polymorph:
     two polymorphs are equally stable (P7); default 0 (no intrinsic energy difference: none
     is published), any finite value: at zero load the wells differ by ``N_M Delta`` per
     length (``Delta``: B's rest twist density minus A's).
+
+    ``transition``: a transition of the library (from ``polymorph_a``'s form to
+    ``polymorph_b``'s; another organism's is allowed, as a stand-in) instead of ``barrier``, ``stiffness`` and ``maxwell_torque``: its two
+    torques read as the spinodals of (P6) and ``domain_wall_width`` ``w`` [m] (or the
+    library's) give ``N_M``, ``W``, ``K`` (:meth:`PolymorphModel.from_thresholds`, with the
+    rod's own ``Delta``). The library quotes Hotani's signs (``from -> to`` at a negative
+    torque); the rod's convention is the opposite (a right-handed twist moment favours the
+    right-handed form), so the torques enter with their signs flipped (docs/polymorph.md,
+    "Sign").
     """
 
     enabled: bool = False
@@ -985,6 +994,8 @@ class Polymorph:
     initial: str = "a"
     wall_position: float = 0.5
     maxwell_torque: float = 0.0
+    transition: str | None = None
+    domain_wall_width: float | None = None
 
     INITIAL = ("a", "b", "wall")
     #: most ``rate`` may exceed its default by (a stiff but finite kinetics)
@@ -1005,11 +1016,19 @@ class Polymorph:
             if v is not None:
                 _positive(f"polymorph.{key}", v, {"barrier": "N", "stiffness": "N m^2",
                                                    "rate": "1/(N s)"}[key])
-        if self.enabled:
+        if self.domain_wall_width is not None:
+            _positive("polymorph.domain_wall_width", self.domain_wall_width, "m")
+        if self.transition is not None:
+            self._check_transition(lib)
+        elif self.domain_wall_width is not None:
+            raise UserInputError("polymorph.domain_wall_width goes with polymorph.transition; "
+                                 "without one the wall is sqrt(2 stiffness / barrier)")
+        if self.enabled and self.transition is None:
             for key, unit in (("barrier", "N"), ("stiffness", "N m^2")):
                 if getattr(self, key) is None:
                     raise UserInputError(f"polymorph.{key} is required when polymorph.enabled "
-                                         f"= true (a value in (0, inf) {unit})")
+                                         f"= true (a value in (0, inf) {unit}), or name a "
+                                         "polymorph.transition of the library")
         if self.initial not in self.INITIAL:
             raise UserInputError(f"polymorph.initial must be one of {', '.join(self.INITIAL)}, "
                                  f"got {self.initial!r}")
@@ -1019,20 +1038,75 @@ class Polymorph:
             raise UserInputError(f"polymorph.wall_position must be in (0, 1) (a fraction of "
                                  f"the contour), got {self.wall_position!r}")
 
+    def _check_transition(self, lib) -> None:
+        if not isinstance(self.transition, str):
+            raise UserInputError(f"polymorph.transition must be a name, got {self.transition!r}")
+        try:
+            t = lib.transition(self.transition)
+        except UserInputError as exc:
+            raise UserInputError(f"polymorph.transition: {exc}") from None
+        # the forms must match; the organism may differ (a stand-in, said in the docs)
+        forms = (lib.polymorph(t.from_key).form, lib.polymorph(t.to_key).form)
+        mine = (lib.polymorph(self.polymorph_a).form, lib.polymorph(self.polymorph_b).form)
+        if forms != mine:
+            raise UserInputError(
+                f"polymorph.transition {t.key!r} goes from the {forms[0]} to the {forms[1]} "
+                f"form, but polymorph_a, polymorph_b are {mine[0]} and {mine[1]}")
+        given = [k for k in ("barrier", "stiffness") if getattr(self, k) is not None]
+        given += ["maxwell_torque"] if self.maxwell_torque != 0.0 else []
+        if given:
+            raise UserInputError(f"polymorph.transition gives the landscape: drop "
+                                 f"{', '.join('polymorph.' + k for k in given)} (or the transition)")
+        for name in ("torque_forward_pn_um", "torque_back_pn_um"):
+            if getattr(t, name).value is None:
+                raise UserInputError(f"polymorph.transition {t.key!r}: {name} is a gap in the "
+                                     "library; give barrier, stiffness and maxwell_torque instead")
+        if self.domain_wall_width is None and t.wall_width_um.value is None:
+            raise UserInputError(
+                f"polymorph.domain_wall_width is required with polymorph.transition = "
+                f"{t.key!r}: the library has no wall width (a gap: {t.wall_width_um.source}); "
+                "give one in [the bead spacing, inf) m")
+
     @property
     def is_default(self) -> bool:
         return self == Polymorph()
 
     def wall_width(self) -> float:
-        """``w = sqrt(2 K / W)`` [m] of the tanh wall (P4)."""
+        """``w`` [m] of the tanh wall (P4): ``sqrt(2 K / W)``, or with a ``transition`` its
+        ``domain_wall_width`` (else the library's)."""
+        if self.transition is not None:
+            if self.domain_wall_width is not None:
+                return float(self.domain_wall_width)
+            return _polymorph_library().transition(self.transition).wall_width_um.value * 1e-6
         return math.sqrt(2.0 * self.stiffness / self.barrier)
+
+    def landscape(self, scales, delta: float) -> tuple[float, float, float, float]:
+        """``(W, K, Gamma, N_M)`` in core units for a filament whose ``Delta`` (B's rest twist
+        density minus A's) is ``delta`` [1/L]: the given values, or those of the
+        ``transition`` (class docstring; :meth:`PolymorphModel.from_thresholds`)."""
+        if self.transition is None:
+            W, K, G = self.core(scales)
+            return W, K, G, self.core_maxwell_torque(scales)
+        from flagwrap.elasticity.polymorph import PolymorphModel
+
+        t = _polymorph_library().transition(self.transition)
+        to_core = 1e-18 / scales.torque  # pN um -> A/L
+        try:
+            m = PolymorphModel.from_thresholds(-t.torque_forward_pn_um.value * to_core,
+                                               -t.torque_back_pn_um.value * to_core, delta,
+                                               self.wall_width() / scales.length)
+        except UserInputError as exc:
+            raise UserInputError(f"polymorph.transition {t.key!r} on this filament: {exc}") from None
+        W, K = m.barrier, m.stiffness
+        G = 5.0 / W if self.rate is None else self.rate * scales.force / scales.omega
+        return W, K, G, m.maxwell_torque
 
     def core_maxwell_torque(self, scales) -> float:
         """``N_M`` in core units ``[A/L]``."""
         return self.maxwell_torque / scales.torque
 
     def core(self, scales) -> tuple[float, float, float]:
-        """``(W, K, Gamma)`` in core units (``W`` per ``A/L^2``, ``K`` per ``A``, ``Gamma`` per
+        """``(W, K, Gamma)`` in core units, given ``barrier`` and ``stiffness`` (``W`` per ``A/L^2``, ``K`` per ``A``, ``Gamma`` per
         ``L^2 / (A T)``); the default rate ``Gamma = 5 / W`` (core)."""
         W = self.barrier / scales.force
         K = self.stiffness / scales.bending

@@ -314,6 +314,8 @@ CONFIGS = [
     ("polymorph", tiny_toml() + POLY.replace("enabled = true", "enabled = 'yes'"), "polymorph.enabled"),
     ("polymorph", tiny_toml() + POLY + "wall_position = 1.5\n", "polymorph.wall_position"),
     ("polymorph", tiny_toml() + POLY + "maxwell_torque = inf\n", "polymorph.maxwell_torque"),
+    ("polymorph", tiny_toml() + POLY + "transition = 'no_such'\n", "polymorph.transition"),
+    ("polymorph", tiny_toml() + POLY + "domain_wall_width = 0.0\n", "polymorph.domain_wall_width"),
 ]
 
 

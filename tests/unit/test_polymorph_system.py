@@ -463,3 +463,49 @@ def test_ecoli_cw_torque_switches_normal_to_semicoiled_from_the_motor(direction,
         first = np.flatnonzero(inb[k])
         assert first.min() < o.shape[1] / 3
         assert 0.1 < inb[-1].mean() < 0.9  # a front that stops: B at the motor, A beyond
+
+
+def test_a_library_transition_gives_the_landscape_with_hotanis_thresholds():
+    """``transition = 'salmonella_normal_semicoiled'`` (Hotani's loop, a stand-in on the E.
+    coli forms) with a 0.5 um wall: the model's spinodal torques (P6) are the library's two
+    torques with the rod's sign, +1.1 and -0.4 pN um, to round-off, its wall is 0.5 um, and
+    its Delta is the rod's own (within 2 % of the continuum torsions' 4.594 /um)."""
+    import dataclasses
+
+    from flagwrap.cases import get_case
+    from flagwrap.simulation import make_system
+
+    base = get_case("ecoli_polymorph")
+    pm = dataclasses.replace(base.polymorph, barrier=None, stiffness=None, maxwell_torque=0.0,
+                             transition="salmonella_normal_semicoiled", domain_wall_width=0.5e-6)
+    s = make_system(base.replace(polymorph=pm))
+    sc = base.scales
+    up, down = (v * sc.torque for v in s.model.switch_torques)
+    assert up == pytest.approx(1.1e-18, rel=1e-12) and down == pytest.approx(-0.4e-18, rel=1e-12)
+    assert s.model.wall_width * sc.length == pytest.approx(0.5e-6, rel=1e-12)
+    assert s.model.delta_twist / sc.length * 1e-6 == pytest.approx(4.594, rel=0.02)
+
+
+@pytest.mark.parametrize("extra, key", [
+    ("transition = 'nope'\n", "polymorph.transition"),
+    ("transition = 'salmonella_normal_semicoiled'\ndomain_wall_width = 0.05\n", "polymorph.barrier"),
+    ("domain_wall_width = 0.05\n", "polymorph.domain_wall_width"),
+    ("domain_wall_width = -0.05\n", "polymorph.domain_wall_width"),
+])
+def test_bad_transition_input_is_one_line_naming_the_key(extra, key):
+    with pytest.raises(UserInputError) as exc:
+        _cfg(POLY + extra)
+    msg = str(exc.value)
+    assert key in msg and "\n" not in msg
+
+
+def test_transition_without_a_wall_width_or_of_other_forms_is_refused():
+    no_wall = ("[polymorph]\nenabled = true\ntransition = 'salmonella_normal_semicoiled'\n")
+    with pytest.raises(UserInputError, match="polymorph.domain_wall_width is required"):
+        _cfg(no_wall)
+    with pytest.raises(UserInputError, match="normal and curly I"):
+        _cfg(no_wall + "domain_wall_width = 0.05\npolymorph_b = 'ecoli_curly1'\n")
+    with pytest.raises(UserInputError, match="polymorph wall width"):  # below the 0.02 m bond
+        _cfg(no_wall + "domain_wall_width = 0.01\n")
+    cfg = _cfg(no_wall + "domain_wall_width = 0.05\n")
+    assert cfg.polymorph.wall_width() == 0.05

@@ -142,7 +142,8 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
         if section == "polymorph":
             # the barrier is an energy per length, a force: bending / length^2 (pN um2 / um2
             # = pN in bacterial units)
-            scale.update(stiffness=bf, barrier=bf / lf**2, maxwell_torque=tf)
+            scale.update(stiffness=bf, barrier=bf / lf**2, maxwell_torque=tf,
+                         domain_wall_width=lf)
         for key, factor in scale.items():
             # numbers only: a bool times a factor would become a float and pass validation
             if _is_number(table.get(key)):

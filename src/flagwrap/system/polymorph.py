@@ -186,17 +186,17 @@ class PolymorphSystem(RodSystem):
         self._kb, self._kappa = np.zeros((n, 3)), np.zeros((n, 2))
         self._twist = np.zeros(n)
         pm = system.config.polymorph
-        W, K, G = pm.core(system.scales) if pm.enabled else (None, None, None)
-        W = W if barrier is None else float(barrier)
-        K = K if stiffness is None else float(stiffness)
-        G = (5.0 / W if G is None else G) if rate is None else float(rate)
         #: its ``Delta`` [1/L]: B's rest twist density minus A's on the transforming
         #: vertices (0 where nothing transforms); the tilt of (P2) at zero load
         #: ``-N_M Delta / 2`` is the wells' intrinsic difference, the load's part comes from
         #: the rod's own twist energy
         c = (self.mbar_b - self.mbar_a)[self.order_changes]
         delta = float(c[0] / self.bond) if c.size else 0.0
-        NM = pm.core_maxwell_torque(system.scales) if pm.enabled else 0.0
+        W, K, G, NM = (pm.landscape(system.scales, delta) if pm.enabled
+                       else (None, None, None, 0.0))
+        W = W if barrier is None else float(barrier)
+        K = K if stiffness is None else float(stiffness)
+        G = (5.0 / W if G is None else G) if rate is None else float(rate)
         self.model = PolymorphModel(barrier=W, stiffness=K, delta_twist=delta, maxwell_torque=NM)
         self.order_rate = G
         l0 = self.parts[0].rest.l0
