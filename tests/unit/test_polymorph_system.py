@@ -325,6 +325,11 @@ def test_polymorph_summary_reads_a_known_front(tmp_path):
     ds["polymorph_order"].values[:] = np.tanh((front[:, None] - (s[None, :] - s0)) / w)
     res = polymorph_summary(ds)
     assert res["starts_at"] == "motor" and res["start_turns"] == ds["turns"].values[0]
+    # semicoiled: half the pitch, the same radius: its helix hangs shorter (a higher free end)
+    fil = cfg.filament
+    assert res["height_a"] == pytest.approx(-fil.pitch / np.hypot(2 * np.pi * fil.helix_radius,
+                                                                   fil.pitch))
+    assert res["height_b"] > res["height_a"]
     assert res["front_speed_m_s"] == pytest.approx(v, rel=0.01)
     sm = s[mask] - s0
     assert res["fraction_b_final"] == pytest.approx(np.mean(sm < front[-1]), abs=1e-12)

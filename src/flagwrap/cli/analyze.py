@@ -144,7 +144,13 @@ def run(args) -> int:
                   f"{w['gap_min_turns']:.2f}), {w['gap_final']:+.3g} m at the end; free end "
                   f"{w['tip_height_final']:.3g} m above it")
         if res.get("polymorph"):
-            print("  " + polymorph_line(res["polymorph"]))
+            pm = res["polymorph"]
+            print("  " + polymorph_line(pm))
+            if pm["fraction_b_max"] > 0 and res.get("buckled"):
+                print(f"  note: the filament changed form; a helix of form {pm['polymorph_a']} hangs "
+                      f"to a height {pm['height_a']:+.3f}, of {pm['polymorph_b']} to "
+                      f"{pm['height_b']:+.3f}: the free end's rise, and so 'buckled', includes "
+                      "the change of form")
         for ph in res["swimming"]:  # a free swimmer, phase by phase (second half of each)
             what = "last turns" if ph["direction"] == "final" else f"{ph['direction']} phase"
             print(f"  swimming, {what} ({ph['t0']:.3g}-{ph['t1']:.3g} s): "

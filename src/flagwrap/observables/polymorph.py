@@ -36,6 +36,10 @@ def polymorph_summary(ds) -> dict | None:
       "middle" or "free end" (last third);
     * ``front_speed_m_s``: the front's speed along the contour, positive away from where B
       began (None without a moving front over at least 3 frames);
+    * ``height_a``, ``height_b``: ``-P/sqrt((2 pi R)^2 + P^2)``, the free end's height
+      ``(z(L) - z(0))/L`` of each form's straight-axis helix hanging from the motor: a change
+      of form moves the free end by their difference, which the buckling verdict (a rise of
+      the free end) cannot tell from a buckle;
     * ``fraction_series`` (time,).
     """
     if "polymorph_order" not in ds.variables:
@@ -53,7 +57,13 @@ def polymorph_summary(ds) -> dict | None:
     frac = inb.mean(axis=1) if mask.any() else np.zeros(len(order))
     turns = ds["turns"].values
     t = ds["time"].values
-    out = {"polymorph_a": ds.attrs.get("polymorph_a", cfg.polymorph.polymorph_a),
+    from flagwrap.system.polymorph import polymorph_geometry
+
+    fil = cfg.filament
+    RB, PB, _ = polymorph_geometry(cfg)
+    out = {"height_a": -fil.pitch / np.hypot(2 * np.pi * fil.helix_radius, fil.pitch),
+           "height_b": -PB / np.hypot(2 * np.pi * RB, PB),
+           "polymorph_a": ds.attrs.get("polymorph_a", cfg.polymorph.polymorph_a),
            "polymorph_b": ds.attrs.get("polymorph_b", cfg.polymorph.polymorph_b),
            "fraction_b_final": float(frac[-1]), "fraction_b_max": float(frac.max()),
            "start_turns": None, "start_time_s": None, "start_position_m": None,
