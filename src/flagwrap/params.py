@@ -1382,17 +1382,15 @@ class Config:
     def _check_polymorph(self) -> None:
         """Refuse a ``[polymorph]`` this version cannot run (one line naming the key): its
         wall narrower than a bond (unresolved, docs/polymorph.md), or a system the polymorph
-        state is not wired into yet (several flagella, the turning frame)."""
+        state is not wired into yet (the turning frame)."""
         from flagwrap.elasticity.polymorph import check_wall_resolution
 
         pm, fil = self.polymorph, self.filament
         check_wall_resolution(pm.wall_width(), fil.bond_length,
                               "polymorph wall width sqrt(2 stiffness / barrier) [m]")
-        for bad, what in ((len(self.flagella) > 1, "several [[flagellum]] tables"),
-                          (self.numerics.frame != "lab", f"numerics.frame = {self.numerics.frame!r}")):
-            if bad:
-                raise UserInputError(f"polymorph.enabled = true is not available with {what} "
-                                     "yet (one filament, held or on a free cell, in the lab frame)")
+        if self.numerics.frame != "lab":
+            raise UserInputError(f"polymorph.enabled = true is not available with numerics.frame "
+                                 f"= {self.numerics.frame!r} yet (the lab frame only)")
 
     def to_dict(self, for_hash: bool = False) -> dict:
         """Plain nested dict (JSON/TOML-able); ``None`` values are dropped.

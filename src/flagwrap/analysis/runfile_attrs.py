@@ -206,11 +206,13 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
 
     wall = wall_summary(ds)
     res["wall"] = None if wall is None else {k: v for k, v in wall.items() if k != "gap_series"}
-    from flagwrap.observables.polymorph import polymorph_summary
+    from flagwrap.observables.polymorph import polymorph_summaries
 
-    poly = polymorph_summary(ds)
-    res["polymorph"] = (None if poly is None else
-                        {k: v for k, v in poly.items() if k != "fraction_series"})
+    poly = polymorph_summaries(ds)  # one per flagellum
+    poly = None if poly is None else [{k: v for k, v in p.items() if k != "fraction_series"}
+                                      for p in poly]
+    res["polymorph"] = None if poly is None else poly[0]
+    res["polymorph_filaments"] = poly if poly is not None and len(poly) > 1 else None
     res["params"] = a.params()
     res["path"] = str(path)
     res["run_status"] = str(ds.attrs.get("status", ""))

@@ -145,8 +145,10 @@ def run(args) -> int:
                   f"{w['tip_height_final']:.3g} m above it")
         if res.get("polymorph"):
             pm = res["polymorph"]
-            print("  " + polymorph_line(pm))
-            if pm["fraction_b_max"] > 0 and res.get("buckled"):
+            many = res.get("polymorph_filaments") or [pm]
+            for k, p in enumerate(many):
+                print("  " + (f"flagellum {k}: " if len(many) > 1 else "") + polymorph_line(p))
+            if any(p["fraction_b_max"] > 0 for p in many) and res.get("buckled"):
                 print(f"  note: the filament changed form; a helix of form {pm['polymorph_a']} hangs "
                       f"to a height {pm['height_a']:+.3f}, of {pm['polymorph_b']} to "
                       f"{pm['height_b']:+.3f}: the free end's rise, and so 'buckled', includes "

@@ -139,27 +139,31 @@ class ElasticForces:
         self.parts = build_parts(config)
         #: a polymorphic filament's two rest shapes (flagwrap.system.polymorph.rest_pair):
         #: :meth:`set_order` moves the rest between them as the simulator does
-        self._pair = None
+        self._pairs = None
         if config.polymorph.enabled:
             import dataclasses
 
             from flagwrap.system.polymorph import rest_pair
 
-            p = self.parts[0]
-            p.rest = dataclasses.replace(p.rest, kbar=p.rest.kbar.copy(), mbar=p.rest.mbar.copy())
-            self._pair = rest_pair(p, config)[:4]
+            self._pairs = []
+            for p in self.parts:
+                p.rest = dataclasses.replace(p.rest, kbar=p.rest.kbar.copy(),
+                                             mbar=p.rest.mbar.copy())
+                self._pairs.append(rest_pair(p, config)[:4])
         self.L = config.scales.length
         self.force_scale = config.scales.force
         self.energy_scale = config.scales.energy
 
     def set_order(self, order) -> None:
-        """A polymorphic filament's rest at its order parameters ``order`` (N,), one frame's
-        (``a + (phi + 1)/2 (b - a)``, as the simulator's ``set_rest``)."""
-        ka, kb, ma, mb = self._pair
-        t = 0.5 * (np.asarray(order, float) + 1.0)
-        rest = self.parts[0].rest
-        rest.kbar[:] = ka + t[:, None] * (kb - ka)
-        rest.mbar[:] = ma + t * (mb - ma)
+        """Polymorphic filaments' rests at the order parameters ``order`` (every bead of the
+        run, one frame's: ``a + (phi + 1)/2 (b - a)``, as the simulator's ``set_rest``)."""
+        order = np.asarray(order, float)
+        start = 0
+        for p, (ka, kb, ma, mb) in zip(self.parts, self._pairs):
+            t = 0.5 * (order[start:start + p.N] + 1.0)
+            p.rest.kbar[:] = ka + t[:, None] * (kb - ka)
+            p.rest.mbar[:] = ma + t * (mb - ma)
+            start += p.N
 
     def rest_twist(self, filament: int = 0) -> np.ndarray:
         """Rest twist ``m_i^0`` [rad] per bead (N,) of flagellum ``filament``."""
@@ -333,7 +337,7 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
     order = ds["polymorph_order"].values if "polymorph_order" in ds.variables else None
     for i in idx:
         name = f"filament_{i:0{width}d}.vtp"
-        if order is not None:  # the rest of this frame's polymorph state (one filament)
+        if order is not None:  # the rests of this frame's polymorph state
             elastic.set_order(order[i])
         pdata = frames_point_data(X[i], M1[i], slices, forces, rest)
         if order is not None:

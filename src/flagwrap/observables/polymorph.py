@@ -17,16 +17,26 @@ import numpy as np
 
 
 def transforming_vertices(config) -> np.ndarray:
-    """(N,) bool: the vertices whose rest shape follows phi, rebuilt from the config (the
-    filament part only: no mobility is built)."""
+    """(N,) bool over every filament's beads: the vertices whose rest shape follows phi,
+    rebuilt from the config (the filaments only: no mobility is built)."""
     from flagwrap.system.parts import build_parts
     from flagwrap.system.polymorph import rest_pair
 
-    return rest_pair(build_parts(config)[0], config)[4]
+    return np.concatenate([rest_pair(p, config)[4] for p in build_parts(config)])
 
 
-def polymorph_summary(ds) -> dict | None:
-    """``None`` for a run without the polymorph state; else
+def polymorph_summaries(ds) -> list | None:
+    """:func:`polymorph_summary` of every flagellum of the run, or ``None`` without the
+    polymorph state."""
+    if "polymorph_order" not in ds.variables:
+        return None
+    from flagwrap.io.runfile import filament_slices
+
+    return [polymorph_summary(ds, k) for k in range(len(filament_slices(ds)))]
+
+
+def polymorph_summary(ds, filament: int = 0) -> dict | None:
+    """``None`` for a run without the polymorph state; else, for flagellum ``filament``,
 
     * ``polymorph_a``, ``polymorph_b``: the two forms' library names;
     * ``fraction_b_final``, ``fraction_b_max``: the fraction of transforming vertices in B;
@@ -44,12 +54,13 @@ def polymorph_summary(ds) -> dict | None:
     """
     if "polymorph_order" not in ds.variables:
         return None
-    from flagwrap.io.runfile import config_of
+    from flagwrap.io.runfile import config_of, filament_slices
 
     cfg = config_of(ds)
-    order = ds["polymorph_order"].values
-    mask = transforming_vertices(cfg)
-    x0 = ds["position"].values[0]
+    sl = filament_slices(ds)[filament]
+    order = ds["polymorph_order"].values[:, sl]
+    mask = transforming_vertices(cfg)[sl]
+    x0 = ds["position"].values[0][sl]
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x0, axis=0), axis=1))])
     s = s - s[np.flatnonzero(mask)[0] - 1] if mask.any() else s  # from the motor's end
     phi, sm = order[:, mask], s[mask]

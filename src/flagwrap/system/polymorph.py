@@ -151,8 +151,8 @@ class PolymorphSystem(RodSystem):
         return object.__new__(cls)
 
     def __init__(self, system, barrier=None, stiffness=None, rate=None, order0=None):
-        if len(system.parts) != 1 or isinstance(system, PolymorphSystem):
-            raise ValueError("PolymorphSystem: one filament, without an order block already")
+        if isinstance(system, PolymorphSystem):
+            raise ValueError("PolymorphSystem: the system has an order block already")
         from flagwrap.system.swimmer import SwimmerSystem
 
         inner = SwimmerSystem if isinstance(self, SwimmerSystem) else RodSystem
@@ -166,23 +166,34 @@ class PolymorphSystem(RodSystem):
         rod.__dict__.update(system.__dict__)
         self.__dict__.update(system.__dict__)  # the same buffers: a view
         self._rod = rod
-        # the filament's rest arrays are rewritten from phi at every evaluation: its own
-        # copy, so the system it was made from keeps its fixed rest shape
-        part = copy.copy(system.parts[0])
-        part.rest = dataclasses.replace(part.rest, kbar=part.rest.kbar.copy(),
-                                        mbar=part.rest.mbar.copy())
-        self.parts = rod.parts = [part]
-        (self.kbar_a, self.kbar_b, self.mbar_a, self.mbar_b,
-         self.order_changes) = rest_pair(part, system.config)
+        # every filament's rest arrays are rewritten from phi at every evaluation: views of
+        # one buffer over all beads (so one vectorised write sets them all), owned here, so
+        # the system it was made from keeps its fixed rest shapes
+        pairs = [rest_pair(p, system.config) for p in system.parts]
+        cat = np.concatenate
+        self.kbar_a, self.kbar_b = cat([q[0] for q in pairs]), cat([q[1] for q in pairs])
+        self.mbar_a, self.mbar_b = cat([q[2] for q in pairs]), cat([q[3] for q in pairs])
+        #: (N,) bool over every filament's beads: the vertices that transform
+        self.order_changes = cat([q[4] for q in pairs])
+        self._kbar_now, self._mbar_now = self.kbar_a.copy(), self.mbar_a.copy()
+        parts = []
+        for p in system.parts:
+            q = copy.copy(p)
+            v = p.beads
+            q.rest = dataclasses.replace(p.rest, kbar=self._kbar_now[v], mbar=self._mbar_now[v])
+            parts.append(q)
+        self.parts = rod.parts = parts
         #: ``d kbar/dphi``, ``d mbar/dphi`` (:func:`~flagwrap.elasticity.polymorph.rest_derivative`)
         self._kbar_ba, self._mbar_ba = self.kbar_b - self.kbar_a, self.mbar_b - self.mbar_a
         self.dkbar = 0.5 * (self.kbar_b - self.kbar_a)
         self.dmbar = 0.5 * (self.mbar_b - self.mbar_a)
+        self._cbend = cat([p.rest.cbend for p in parts])
+        self._ctwist = cat([p.rest.ctwist for p in parts])
         # d2 E_el / dphi2 at each vertex, constant: the energy is quadratic in the rest values
-        self.order_elastic_curvature = (part.rest.cbend * np.sum(self.dkbar**2, axis=1)
-                                        + part.rest.ctwist * self.dmbar**2)
-        n = part.N
-        self._m1, self._m2 = np.empty((n - 1, 3)), np.empty((n - 1, 3))
+        self.order_elastic_curvature = (self._cbend * np.sum(self.dkbar**2, axis=1)
+                                        + self._ctwist * self.dmbar**2)
+        n, nbond = self.N, self.N - len(parts)
+        self._m1, self._m2 = np.empty((nbond, 3)), np.empty((nbond, 3))
         self._kb, self._kappa = np.zeros((n, 3)), np.zeros((n, 2))
         self._twist = np.zeros(n)
         pm = system.config.polymorph
@@ -190,7 +201,7 @@ class PolymorphSystem(RodSystem):
         #: vertices (0 where nothing transforms); the tilt of (P2) at zero load
         #: ``-N_M Delta / 2`` is the wells' intrinsic difference, the load's part comes from
         #: the rod's own twist energy
-        c = (self.mbar_b - self.mbar_a)[self.order_changes]
+        c = (self.mbar_b - self.mbar_a)[self.order_changes]  # every filament's the same
         delta = float(c[0] / self.bond) if c.size else 0.0
         W, K, G, NM = (pm.landscape(system.scales, delta) if pm.enabled
                        else (None, None, None, 0.0))
@@ -199,9 +210,10 @@ class PolymorphSystem(RodSystem):
         G = (5.0 / W if G is None else G) if rate is None else float(rate)
         self.model = PolymorphModel(barrier=W, stiffness=K, delta_twist=delta, maxwell_torque=NM)
         self.order_rate = G
-        l0 = self.parts[0].rest.l0
-        self.order_vor = voronoi_lengths(l0)
-        self.order_bonds = np.asarray(l0, float)
+        #: each filament's Voronoi lengths and rest bonds, one after the other: (P3) on each
+        #: filament's chain, no gradient energy between two filaments
+        self.order_vor = cat([voronoi_lengths(p.rest.l0) for p in parts])
+        self.order_bonds = cat([np.asarray(p.rest.l0, float) for p in parts])
         n = len(self.order_vor)
         self.layout = DofLayout([(b.name, b.kind, b.size) for b in system.layout.blocks]
                                 + [("order", "order", n)])
@@ -222,14 +234,34 @@ class PolymorphSystem(RodSystem):
 
     def initial_order(self, pm) -> np.ndarray:
         """``config.polymorph.initial``: uniform A (-1), uniform B (+1), or the wall (P4)
-        centred at ``wall_position`` of the rest contour, A at the motor."""
+        centred at ``wall_position`` of each filament's rest contour, A at its motor."""
         n = len(self.order_vor)
         if pm.initial == "a":
             return -np.ones(n)
         if pm.initial == "b":
             return np.ones(n)
-        s = np.concatenate([[0.0], np.cumsum(self.order_bonds)])
-        return wall_profile(s, pm.wall_position * s[-1], self.model.wall_width)
+        out = np.empty(n)
+        for p in self.parts:
+            s = np.concatenate([[0.0], np.cumsum(p.rest.l0)])
+            out[p.beads] = wall_profile(s, pm.wall_position * s[-1], self.model.wall_width)
+        return out
+
+    def _chains(self):
+        """Each filament's ``(beads, bonds)`` slices in the block and in ``order_bonds``."""
+        return [(p.beads, p.bonds) for p in self.parts]
+
+    def order_energy(self, phi) -> float:
+        """(P3) summed over the filaments."""
+        return sum(total_energy(phi[v], self.model, 0.0, self.order_vor[v], self.order_bonds[e])
+                   for v, e in self._chains())
+
+    def order_energy_grad(self, phi) -> np.ndarray:
+        """The gradient of :meth:`order_energy`."""
+        out = np.empty(len(phi))
+        for v, e in self._chains():
+            out[v] = total_energy_grad(phi[v], self.model, 0.0, self.order_vor[v],
+                                       self.order_bonds[e])
+        return out
 
     # state ---------------------------------------------------------------------------------
     def pack(self, x, theta, phi, *pose, order=None, **kw) -> np.ndarray:
@@ -252,27 +284,27 @@ class PolymorphSystem(RodSystem):
     def set_rest(self, y) -> None:
         """Write the rest curvature and twist at ``y``'s order parameters into the
         filament's rest arrays (``a + (phi + 1)/2 (b - a)``, bit for bit ``a`` where the two
-        polymorphs coincide): every evaluation of the rod at ``y`` starts here."""
-        rest = self.parts[0].rest
+        polymorphs coincide): every evaluation of the rod at ``y`` starts here. The
+        filaments' rest arrays are views of the two buffers written here."""
         t = 0.5 * (y[self.sl_order] + 1.0)
-        np.multiply(t[:, None], self._kbar_ba, out=rest.kbar)
-        np.add(rest.kbar, self.kbar_a, out=rest.kbar)
-        np.multiply(t, self._mbar_ba, out=rest.mbar)
-        np.add(rest.mbar, self.mbar_a, out=rest.mbar)
+        np.multiply(t[:, None], self._kbar_ba, out=self._kbar_now)
+        np.add(self._kbar_now, self.kbar_a, out=self._kbar_now)
+        np.multiply(t, self._mbar_ba, out=self._mbar_now)
+        np.add(self._mbar_now, self.mbar_a, out=self._mbar_now)
 
     def elastic_order_gradient(self, info) -> np.ndarray:
         """``dE_el/dphi_i`` at the state of ``info`` (rest set at its ``phi``):
         ``-cbend_i (kappa_i - kbar_i).dkbar_i - ctwist_i (m_i - mbar_i) dmbar_i``
         (:func:`~flagwrap.elasticity.polymorph.elastic_phi_gradient`), with the material
         curvatures and twists the kernel measures (:mod:`flagwrap.elasticity._kernels`)."""
-        rest = self.parts[0].rest
-        fr = info.frames
-        EK.material_frames(fr.t, fr.d1, info.theta, self._m1, self._m2)
-        EK.curvatures(fr.t, self._m1, self._m2, self._kb, self._kappa)
-        m = self._twist
-        m[1:-1] = info.theta[1:] - info.theta[:-1] + fr.rt[1:-1]
-        out = -rest.cbend * np.sum((self._kappa - rest.kbar) * self.dkbar, axis=1)
-        out -= rest.ctwist * (m - rest.mbar) * self.dmbar
+        fr, th = info.frames, info.theta
+        for v, e in self._chains():  # each filament's own chain of bonds and vertices
+            EK.material_frames(fr.t[e], fr.d1[e], th[e], self._m1[e], self._m2[e])
+            EK.curvatures(fr.t[e], self._m1[e], self._m2[e], self._kb[v], self._kappa[v])
+            m = self._twist[v]
+            m[1:-1] = th[e][1:] - th[e][:-1] + fr.rt[v][1:-1]
+        out = -self._cbend * np.sum((self._kappa - self._kbar_now) * self.dkbar, axis=1)
+        out -= self._ctwist * (self._twist - self._mbar_now) * self.dmbar
         return out
 
     def forces(self, y, base):
@@ -281,11 +313,9 @@ class PolymorphSystem(RodSystem):
         self.set_rest(y)
         info = super().forces(y, base)
         phi = y[self.sl_order]
-        info.G[self.sl_order] = -total_energy_grad(phi, self.model, 0.0, self.order_vor,
-                                                   self.order_bonds)
+        info.G[self.sl_order] = -self.order_energy_grad(phi)
         info.G[self.sl_order] -= self.elastic_order_gradient(info)
-        info.polymorph_energy = total_energy(phi, self.model, 0.0, self.order_vor,
-                                             self.order_bonds)
+        info.polymorph_energy = self.order_energy(phi)
         return info
 
     def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
@@ -320,9 +350,16 @@ class PolymorphSystem(RodSystem):
         return rows, cols, -np.concatenate([main, off, off])
 
     def order_hessian_bands(self, y):
-        """The block's Hessian (tridiagonal): (P3)'s plus the rod's ``d2E_el/dphi_i2``."""
-        main, off = total_energy_hessian_bands(y[self.sl_order], self.model, self.order_vor,
-                                               self.order_bonds)
+        """The block's Hessian (tridiagonal): (P3)'s plus the rod's ``d2E_el/dphi_i2``; the
+        off-diagonal is 0 between two filaments' chains."""
+        phi = y[self.sl_order]
+        main = np.empty(len(phi))
+        off = np.zeros(len(phi) - 1)
+        for v, e in self._chains():
+            mv, ov = total_energy_hessian_bands(phi[v], self.model, self.order_vor[v],
+                                                self.order_bonds[e])
+            main[v] = mv
+            off[v.start:v.stop - 1] = ov
         main += self.order_elastic_curvature
         return main, off
 
