@@ -43,14 +43,18 @@ def main(argv=None):
     args = p.parse_args(argv)
     base = load_config(args.config)
     pm = base.polymorph
-    W, _, G = pm.core(base.scales)
-    rate = G * args.rate_scale * base.scales.omega / base.scales.force  # core -> 1/(N s)
-    base = base.replace(polymorph=dataclasses.replace(
-        pm, stiffness=pm.stiffness * args.wall_scale**2,
-        rate=pm.rate if args.rate_scale == 1.0 else rate))
-    if args.n_beads:
-        base = base.replace(filament=dataclasses.replace(
-            base.filament, n_beads=args.n_beads, pitch_angle_deg=None, turns=None))
+    changes = {}
+    if args.wall_scale != 1.0:  # the wall's width times F: the stiffness times F^2
+        if pm.transition is not None:
+            changes["domain_wall_width"] = pm.wall_width() * args.wall_scale
+        else:
+            changes["stiffness"] = pm.stiffness * args.wall_scale**2
+    if args.rate_scale != 1.0:  # of the rate the system uses (the default when unset)
+        from flagwrap.simulation import make_system
+
+        g = make_system(base).order_rate * args.rate_scale  # core
+        changes["rate"] = g * base.scales.omega / base.scales.force  # -> 1/(N s)
+    base = base.replace(polymorph=dataclasses.replace(pm, **changes))
     for hz in args.hz:
         motor = dataclasses.replace(base.motor, kind="speed", frequency=hz, machin=None,
                                     stall_torque=None, zero_load_speed=None,

@@ -1387,7 +1387,15 @@ class Config:
 
         pm, fil = self.polymorph, self.filament
         check_wall_resolution(pm.wall_width(), fil.bond_length,
-                              "polymorph wall width sqrt(2 stiffness / barrier) [m]")
+                              "polymorph.domain_wall_width [m]" if pm.transition is not None
+                              else "polymorph wall width sqrt(2 stiffness / barrier) [m]")
+        hand_a = _polymorph_library().polymorph(pm.polymorph_a).handedness.value
+        if fil.shape == "helix" and fil.handedness != hand_a:
+            # B's hand is taken relative to the filament's (polymorph_geometry): a filament
+            # of the other hand would turn the switch around
+            raise UserInputError(
+                f"filament.handedness = {fil.handedness!r} but polymorph.polymorph_a = "
+                f"{pm.polymorph_a!r} is {hand_a}-handed: the configured filament is polymorph A")
         if self.numerics.frame != "lab":
             raise UserInputError(f"polymorph.enabled = true is not available with numerics.frame "
                                  f"= {self.numerics.frame!r} yet (the lab frame only)")

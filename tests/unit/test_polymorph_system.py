@@ -319,22 +319,24 @@ def test_polymorph_summary_reads_a_known_front(tmp_path):
     mask = transforming_vertices(cfg)
     x0 = ds["position"].values[0]
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x0, axis=0), axis=1))])
-    s0 = s[np.flatnonzero(mask)[0] - 1]
     t = ds["time"].values
     L = cfg.filament.length
     v = 0.6 * L / t[-1]  # crosses 60 % of the filament over the run
     w = 2 * cfg.filament.bond_length
     front = 0.15 * L + v * (t - t[0])
-    ds["polymorph_order"].values[:] = np.tanh((front[:, None] - (s[None, :] - s0)) / w)
+    order = np.tanh((front[:, None] - s[None, :]) / w)
+    order[0] = -1.0  # all A at first: B appears in the second frame, at the motor
+    ds["polymorph_order"].values[:] = order
     res = polymorph_summary(ds)
-    assert res["starts_at"] == "motor" and res["start_turns"] == ds["turns"].values[0]
+    assert res["starts_at"] == "motor" and res["start_turns"] == ds["turns"].values[1]
+    assert res["start_position_m"] < 0.2 * L
     # semicoiled: half the pitch, the same radius: its helix hangs shorter (a higher free end)
     fil = cfg.filament
     assert res["height_a"] == pytest.approx(-fil.pitch / np.hypot(2 * np.pi * fil.helix_radius,
                                                                    fil.pitch))
     assert res["height_b"] > res["height_a"]
     assert res["front_speed_m_s"] == pytest.approx(v, rel=0.01)
-    sm = s[mask] - s0
+    sm = s[mask]
     assert res["fraction_b_final"] == pytest.approx(np.mean(sm < front[-1]), abs=1e-12)
 
 
@@ -513,7 +515,7 @@ def test_transition_without_a_wall_width_or_of_other_forms_is_refused():
         _cfg(no_wall)
     with pytest.raises(UserInputError, match="normal and curly I"):
         _cfg(no_wall + "domain_wall_width = 0.05\npolymorph_b = 'ecoli_curly1'\n")
-    with pytest.raises(UserInputError, match="polymorph wall width"):  # below the 0.02 m bond
+    with pytest.raises(UserInputError, match="polymorph.domain_wall_width"):  # < the 0.02 m bond
         _cfg(no_wall + "domain_wall_width = 0.01\n")
     cfg = _cfg(no_wall + "domain_wall_width = 0.05\n")
     assert cfg.polymorph.wall_width() == 0.05
@@ -544,3 +546,33 @@ def test_two_flagella_analysis_and_vtk_read_each_filaments_order(tmp_path, capsy
                      for k, sl in enumerate(sls)))
     stored = ds["elastic_energy"].values
     np.testing.assert_allclose(E, stored, rtol=1e-8, atol=1e-12 * stored.max())
+
+
+def test_b_in_the_initial_state_is_not_called_a_transformation(tmp_path):
+    """``initial = 'wall'``: the first frame already holds B, which the summary reports as
+    present from the start (no start position), not as a transformation at turn 0."""
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.observables.polymorph import polymorph_summary
+    from flagwrap.simulation import simulate
+
+    ds = read_run(write_run(simulate(_cfg(POLY + "initial = 'wall'\n", ccw=0.05, cw=0.05)),
+                            tmp_path / "w.nc"))
+    res = polymorph_summary(ds)
+    assert res["starts_at"] == "present at the start" and res["start_position_m"] is None
+    assert 0.3 < res["fraction_b_final"] < 0.7
+
+
+def test_filament_of_the_other_hand_and_an_absurd_rate_are_refused():
+    """The configured filament is polymorph A: a right-handed filament named ecoli_normal
+    (left-handed) is refused naming both keys; a rate above 1e6 times the default is
+    refused naming polymorph.rate (at the system's build, before any step)."""
+    from flagwrap.simulation import make_system
+
+    with pytest.raises(UserInputError, match="filament.handedness.*polymorph.polymorph_a"):
+        config_from_dict(tomllib.loads(
+            tiny_toml().replace("turns = 2\n", "turns = 2\nhandedness = 'right'\n") + POLY))
+    with pytest.raises(UserInputError, match="polymorph.rate must be in"):
+        make_system(_cfg(POLY + "rate = 1e300\n"))
+    with pytest.raises(UserInputError, match="polymorph.domain_wall_width"):
+        _cfg("[polymorph]\nenabled = true\ntransition = 'salmonella_normal_semicoiled'\n"
+             "domain_wall_width = 0.001\n")

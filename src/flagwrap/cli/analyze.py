@@ -172,8 +172,11 @@ def polymorph_line(p: dict) -> str:
         return head + f"; never entered {p['polymorph_b']}"
     front = ("no moving front" if p["front_speed_m_s"] is None
              else f"front {p['front_speed_m_s'] * 1e6:+.3g} um/s")
+    if p["start_position_m"] is None:  # the initial state already held B
+        return head + f"; {p['polymorph_b']} present from the start, {front}"
     return (head + f"; began at turn {p['start_turns']:.2f} ({p['start_time_s']:.3g} s), "
-            f"{p['start_position_m'] * 1e6:.3g} um from the motor (the {p['starts_at']}), {front}")
+            f"{p['start_position_m'] * 1e6:.3g} um from the filament's first bead (the "
+            f"{p['starts_at']}), {front}")
 
 
 def stored_line(path) -> str:

@@ -42,8 +42,10 @@ def polymorph_summary(ds, filament: int = 0) -> dict | None:
     * ``fraction_b_final``, ``fraction_b_max``: the fraction of transforming vertices in B;
     * ``start_turns``, ``start_time_s``: the first frame with any vertex in B (None: never);
     * ``start_position_m``, ``start_fraction``: that vertex's contour distance from the
-      motor [m] and as a fraction of the filament; ``starts_at``: "motor" (first third),
-      "middle" or "free end" (last third);
+      filament's first bead (the motor's end) [m], and its place along the transforming
+      vertices as a fraction; ``starts_at``: "motor" (first third), "middle" or "free end"
+      (last third), or "present at the start" when the first frame already holds B (the
+      configured initial state, not a transformation: no start position then);
     * ``front_speed_m_s``: the front's speed along the contour, positive away from where B
       began (None without a moving front over at least 3 frames);
     * ``height_a``, ``height_b``: ``-P/sqrt((2 pi R)^2 + P^2)``, the free end's height
@@ -61,8 +63,8 @@ def polymorph_summary(ds, filament: int = 0) -> dict | None:
     order = ds["polymorph_order"].values[:, sl]
     mask = transforming_vertices(cfg)[sl]
     x0 = ds["position"].values[0][sl]
+    # contour distance from the filament's first bead (the motor's end of its chain)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x0, axis=0), axis=1))])
-    s = s - s[np.flatnonzero(mask)[0] - 1] if mask.any() else s  # from the motor's end
     phi, sm = order[:, mask], s[mask]
     inb = phi > 0.0
     frac = inb.mean(axis=1) if mask.any() else np.zeros(len(order))
@@ -89,9 +91,13 @@ def polymorph_summary(ds, filament: int = 0) -> dict | None:
     j0 = int(first[np.argmax(phi[k0, first])])
     length = float(sm[-1] - sm[0]) if len(sm) > 1 else 1.0
     where = (sm[j0] - sm[0]) / length
-    out.update(start_turns=float(turns[k0]), start_time_s=float(t[k0]),
-               start_position_m=float(sm[j0]), start_fraction=float(where),
-               starts_at="motor" if where < 1 / 3 else ("free end" if where > 2 / 3 else "middle"))
+    out.update(start_turns=float(turns[k0]), start_time_s=float(t[k0]))
+    if k0 == 0:
+        out["starts_at"] = "present at the start"
+    else:
+        out.update(start_position_m=float(sm[j0]), start_fraction=float(where),
+                   starts_at="motor" if where < 1 / 3 else
+                   ("free end" if where > 2 / 3 else "middle"))
     fronts, times = [], []
     for k in range(k0, len(order)):
         if not 0.0 < frac[k] < 1.0:

@@ -208,6 +208,13 @@ class PolymorphSystem(RodSystem):
         W = W if barrier is None else float(barrier)
         K = K if stiffness is None else float(stiffness)
         G = (5.0 / W if G is None else G) if rate is None else float(rate)
+        if pm.enabled and pm.rate is not None and rate is None \
+                and G > pm.MAX_RATE_FACTOR * 5.0 / W:
+            from flagwrap.errors import UserInputError
+
+            most = pm.MAX_RATE_FACTOR * 5.0 / W * system.scales.omega / system.scales.force
+            raise UserInputError(f"polymorph.rate must be in (0, {most:.3g}] 1/(N s) (1e6 times "
+                                 f"the default 5 omega / W), got {pm.rate!r}")
         self.model = PolymorphModel(barrier=W, stiffness=K, delta_twist=delta, maxwell_torque=NM)
         self.order_rate = G
         #: each filament's Voronoi lengths and rest bonds, one after the other: (P3) on each
@@ -424,6 +431,11 @@ def _swimmer_class():
 
         def _body(self, y):
             return self._rod._body(y[:self.n_inner])
+
+        def mobility_matrix(self, y, *args, **kwargs):
+            raise NotImplementedError(
+                "PolymorphSwimmer.mobility_matrix: the swimmer's own matrix covers the "
+                "filament's unknowns only (its stage solver, SwimmerW, builds the pose rows)")
 
     return PolymorphSwimmer
 
