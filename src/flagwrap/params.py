@@ -1381,8 +1381,8 @@ class Config:
 
     def _check_polymorph(self) -> None:
         """Refuse a ``[polymorph]`` this version cannot run (one line naming the key): its
-        wall narrower than a bond (unresolved, docs/polymorph.md), or a system the polymorph
-        state is not wired into yet (the turning frame)."""
+        wall narrower than a bond (unresolved, docs/polymorph.md), or a filament of the other
+        hand than ``polymorph_a``."""
         from flagwrap.elasticity.polymorph import check_wall_resolution
 
         pm, fil = self.polymorph, self.filament
@@ -1396,9 +1396,6 @@ class Config:
             raise UserInputError(
                 f"filament.handedness = {fil.handedness!r} but polymorph.polymorph_a = "
                 f"{pm.polymorph_a!r} is {hand_a}-handed: the configured filament is polymorph A")
-        if self.numerics.frame != "lab":
-            raise UserInputError(f"polymorph.enabled = true is not available with numerics.frame "
-                                 f"= {self.numerics.frame!r} yet (the lab frame only)")
 
     def to_dict(self, for_hash: bool = False) -> dict:
         """Plain nested dict (JSON/TOML-able); ``None`` values are dropped.

@@ -140,25 +140,29 @@ class PolymorphSystem(RodSystem):
     The block follows all of ``system``'s unknowns (``y = [system's y | order]``). Its
     methods add the block to ``system``'s own (``super()``): for a free swimmer
     (:class:`~flagwrap.system.swimmer.SwimmerSystem`) the instance is a
-    :class:`PolymorphSwimmer`, whose next class is the swimmer's. ``_rod`` is a view of
+    :class:`PolymorphSwimmer`, whose next class is the swimmer's; in the turning frame a
+    :class:`PolymorphRotating`. ``_rod`` is a view of
     ``system`` over its own unknowns, the stage solvers' system."""
 
     def __new__(cls, system, *args, **kwargs):
+        from flagwrap.system.rotating import RotatingSystem
         from flagwrap.system.swimmer import SwimmerSystem
 
-        if isinstance(system, SwimmerSystem) and not issubclass(cls, SwimmerSystem):
-            cls = PolymorphSwimmer
+        if cls is PolymorphSystem:
+            if isinstance(system, SwimmerSystem):
+                cls = PolymorphSwimmer
+            elif isinstance(system, RotatingSystem):
+                cls = PolymorphRotating
         return object.__new__(cls)
 
     def __init__(self, system, barrier=None, stiffness=None, rate=None, order0=None):
         if isinstance(system, PolymorphSystem):
             raise ValueError("PolymorphSystem: the system has an order block already")
-        from flagwrap.system.swimmer import SwimmerSystem
-
-        inner = SwimmerSystem if isinstance(self, SwimmerSystem) else RodSystem
+        inner = next((c for c in type(self).__mro__[1:] if issubclass(c, RodSystem)
+                      and not issubclass(c, PolymorphSystem)), RodSystem)
         if type(system) is not inner:
             raise ValueError(f"PolymorphSystem: a {type(system).__name__} is not supported "
-                             "(the lab-frame rig or a free swimmer)")
+                             "(the lab-frame rig, the turning frame or a free swimmer)")
         import copy
         import dataclasses
 
@@ -441,3 +445,18 @@ def _swimmer_class():
 
 
 PolymorphSwimmer = _swimmer_class()
+
+
+def _rotating_class():
+    from flagwrap.system.rotating import RotatingSystem
+
+    class PolymorphRotating(PolymorphSystem, RotatingSystem):
+        """The rig in the frame turning with its motor (:class:`~flagwrap.system.rotating.
+        RotatingSystem`) with the order block. The order parameters are scalars carried by
+        the material, so the frame adds no term to their rate; the forces on them read
+        curvatures and twists, which the rotation leaves unchanged."""
+
+    return PolymorphRotating
+
+
+PolymorphRotating = _rotating_class()
