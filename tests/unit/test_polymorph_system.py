@@ -333,9 +333,10 @@ def test_polymorph_summary_reads_a_known_front(tmp_path):
     assert res["fraction_b_final"] == pytest.approx(np.mean(sm < front[-1]), abs=1e-12)
 
 
-def test_cli_analyze_reports_the_polymorph_and_stability_refuses_it(tmp_path, capsys):
+def test_cli_analyze_reports_the_polymorph_and_stability_refuses_a_free_one(tmp_path, capsys):
     """``flagwrap analyze`` prints the polymorph line of a polymorph run (and none for a
-    fixed-shape one); ``flagwrap stability`` refuses a polymorph config by name, exit 2,
+    fixed-shape one); ``flagwrap stability`` refuses a polymorph config on a free cell (and
+    its ``--far``) by name, exit 2,
     before any work."""
     from flagwrap.cli.main import main
 
@@ -350,10 +351,12 @@ def test_cli_analyze_reports_the_polymorph_and_stability_refuses_it(tmp_path, ca
         assert main(["analyze", str(out), "--no-store"]) == 0
         text = capsys.readouterr().out
         assert (expect in text) if expect else ("polymorph" not in text)
-    cfg.write_text(tiny_toml() + POLY + body)
-    assert main(["stability", str(cfg)]) == 2
-    err = capsys.readouterr().err
-    assert "polymorph.enabled" in err and err.count("\n") == 1
+    for extra, args in (("[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n",
+                         []), (body, ["--far"])):
+        cfg.write_text(tiny_toml() + POLY + extra)
+        assert main(["stability", str(cfg), "--no-progress"] + args) == 2
+        err = capsys.readouterr().err
+        assert "polymorph.enabled" in err and err.count("\n") == 1
 
 
 def test_tube_is_coloured_by_polymorph():
@@ -590,3 +593,54 @@ def test_turning_frame_and_lab_frame_agree_with_the_order_block():
     assert np.abs(oa[-1] - oa[0]).max() > 0.3
     assert np.abs(oa[-1] - ob[-1]).max() < 2e-4
     assert np.abs(np.asarray(a.x)[-1] - np.asarray(b.x)[-1]).max() < 1e-4
+
+
+
+def _tiny_stability_cfg(extra=""):
+    return _cfg("[body]\nenabled = true\n" + POLY + extra)
+
+
+def test_one_state_filament_has_the_fixed_rods_threshold():
+    """Linear stability with the order block: a one-state filament's order modes decouple
+    (no rest shape to move), so its M_c is the fixed rod's, bisection bracket for bracket; a
+    two-state (normal -> semicoiled) filament has another (measured 1351.8 vs 1323.8)."""
+    from flagwrap.stability.threshold import critical_from_config
+
+    plain = critical_from_config(_cfg("[body]\nenabled = true\n"), "cw", m_start=400.0)
+    one = critical_from_config(_tiny_stability_cfg("polymorph_b = 'ecoli_normal'\n"), "cw",
+                               m_start=400.0)
+    two = critical_from_config(_tiny_stability_cfg(), "cw", m_start=400.0)
+    # the same bisection steps; M_c interpolated inside the bracket from eigenvalues whose
+    # finite-difference noise is ~1e-10 (measured 4e-10 apart)
+    assert one.bracket == plain.bracket
+    assert one.machin_c == pytest.approx(plain.machin_c, rel=1e-8)
+    assert one.crossing == plain.crossing
+    assert abs(two.machin_c / plain.machin_c - 1.0) > 0.005
+
+
+def test_polymorph_frame_jacobian_is_the_derivative_of_its_velocity():
+    """``PolymorphFrame.jacobian`` (the rod's block plus the order's cross blocks) against
+    central differences of ``velocity`` over every unknown, at a steady whirl of the
+    two-state filament: each block to 1e-7 of its largest entry (measured 2e-10; central
+    differences with step 1e-6 carry ~1e-10 relative error)."""
+    from flagwrap.stability.steady import start_state
+    from flagwrap.stability.threshold import make_frame
+
+    fr = make_frame(_tiny_stability_cfg(), -1.0)
+    st = start_state(fr, 1000.0)
+    assert st.converged
+    J = fr.jacobian(st.z, st.base, st.machin, st.info)
+    h = 1e-6
+    Jfd = np.empty_like(J)
+    for k in range(fr.n):
+        zp, zm = st.z.copy(), st.z.copy()
+        zp[k] += h
+        zm[k] -= h
+        Jfd[:, k] = (fr.velocity(zp, st.base, st.machin)[0]
+                     - fr.velocity(zm, st.base, st.machin)[0]) / (2 * h)
+    nr = fr.n_rod
+    for r, c in ((slice(0, nr), slice(0, nr)), (slice(0, nr), slice(nr, None)),
+                 (slice(nr, None), slice(0, nr)), (slice(nr, None), slice(nr, None))):
+        scale = np.abs(Jfd[r, c]).max()
+        assert scale > 0
+        assert np.abs(J[r, c] - Jfd[r, c]).max() < 1e-7 * scale

@@ -489,6 +489,10 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     check_diagram_options(m_far, m_lo, m_hi, settle, factor, cycles)
     if direction not in DIRECTIONS:
         raise UserInputError(f"direction must be 'cw' or 'ccw', got {direction!r}")
+    if config.polymorph.enabled:
+        raise UserInputError("flagwrap stability --far: a polymorphic filament's far branch is "
+                             "not followed yet (its whirl's M_c is: drop --far); set "
+                             "polymorph.enabled = false for the fixed shape of polymorph_a")
     if config.body.free:
         raise UserInputError("flagwrap stability --diagram: a free-swimming cell's far states "
                              "are not followed (only a held cell's or the rig's): set "

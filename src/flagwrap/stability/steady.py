@@ -130,7 +130,9 @@ def newton(frame, machin: float, z0: np.ndarray, base0, step_tol: float = 1e-10,
 def initial_guess(frame):
     """The rest shape in the turning frame: ``(z, base)``."""
     s = frame.system
-    return s.initial_y()[:frame.n].copy(), s.frames0.copy()
+    own = getattr(frame, "initial_z", None)  # a frame whose unknowns are not y's first n
+    z = own() if own is not None else s.initial_y()[:frame.n].copy()
+    return z, s.frames0.copy()
 
 
 def extrapolate(frame, a: SteadyState, b: SteadyState, machin: float) -> np.ndarray:

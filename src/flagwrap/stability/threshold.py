@@ -248,14 +248,15 @@ def resolve_m_max(config, m_start: float, m_max: float | None) -> float:
 
 
 def refuse_polymorph(config) -> None:
-    """A one-line :class:`UserInputError` for a polymorphic filament: its order parameters
-    are not unknowns of the turning frame yet (docs/polymorph.md)."""
-    if config.polymorph.enabled:
+    """A one-line :class:`UserInputError` for a polymorphic filament linear stability does
+    not take yet: on a free cell or with several flagella (docs/polymorph.md)."""
+    if config.polymorph.enabled and (config.body.free or len(config.flagella) > 1):
+        what = "body.motion = 'free'" if config.body.free else "several [[flagellum]] tables"
         raise UserInputError(
-            "polymorph.enabled = true is not available to flagwrap stability (the turning frame "
-            "does not carry the order parameter yet); run it in the time domain (flagwrap run, "
-            "or studies/polymorph_switch.py for the switching torque), or set polymorph.enabled "
-            "= false for the fixed shape of polymorph_a")
+            f"polymorph.enabled = true with {what} is not available to flagwrap stability yet "
+            "(one polymorphic filament on the rig or a held cell); run it in the time domain "
+            "(flagwrap run), or set polymorph.enabled = false for the fixed shape of "
+            "polymorph_a")
 
 
 def make_frame(config, omega: float):
@@ -276,6 +277,11 @@ def make_frame(config, omega: float):
     from flagwrap.system.rod_system import RodSystem
     from flagwrap.system.rotating import RotatingFrame
 
+    if config.polymorph.enabled:  # the order parameters among the unknowns
+        from flagwrap.system.polymorph import PolymorphFrame, PolymorphSystem
+
+        return PolymorphFrame(PolymorphSystem(RodSystem(config)), omega,
+                              blob_body=config.body.no_slip)
     return RotatingFrame(RodSystem(config), omega, blob_body=config.body.no_slip)
 
 

@@ -460,3 +460,101 @@ def _rotating_class():
 
 
 PolymorphRotating = _rotating_class()
+
+
+class PolymorphFrame:
+    """A polymorphic rig (:class:`PolymorphSystem` over the lab-frame ``RodSystem``) in the
+    frame turning with its motor at ``omega``, for linear stability (:mod:`flagwrap.stability`):
+    the interface of :class:`~flagwrap.system.rotating.RotatingFrame`, with the order
+    parameters among the unknowns.
+
+    ``z = [x', theta', order]``: the lab state without the motor angle (which sits between
+    the rod's unknowns and the order block), in the turning frame. The order parameters get
+    no rotation term (scalars carried by the material). Their kinetics scales with the Machin
+    number as the mobilities do: ``Gamma`` fixed in SI, so its core value goes as ``1/M``
+    along a continuation in ``M`` (the steady states do not depend on ``Gamma``, only the
+    order's eigenvalues do).
+
+    The Jacobian is exact, cross terms included, as linear stability needs (the time
+    stepper's ``W`` leaves them out). The rod's block is the rig's own turning-frame Jacobian
+    at the order parameters held fixed (:meth:`RotatingFrame.jacobian` of the system's rod
+    view). The other blocks are central differences of the generalized forces over the order
+    columns and of the order's forces over the rod's columns, times the mobilities, which do
+    not depend on ``phi``.
+    """
+
+    def __init__(self, system, omega: float, blob_body: bool = False):
+        from flagwrap.system.rotating import RotatingFrame
+
+        if not isinstance(system, PolymorphSystem) or type(system._rod) is not RodSystem:
+            raise ValueError("PolymorphFrame: a PolymorphSystem over the lab-frame RodSystem")
+        self.system = system
+        self.rod_frame = RotatingFrame(system._rod, omega, blob_body=blob_body)
+        self.omega = self.rod_frame.omega
+        self.axis = self.rod_frame.axis
+        self.i_phi = system.i_phi
+        self.n_rod = system.n_rod - 1  # the rod's unknowns in z
+        self.n = system.ny - 1
+        self.n3 = 3 * system.nb
+
+    def full(self, z) -> np.ndarray:
+        """The lab state vector at ``phi = 0`` (where both frames coincide)."""
+        return np.insert(np.asarray(z, float), self.i_phi, 0.0)
+
+    def initial_z(self) -> np.ndarray:
+        """The configured initial state without the motor angle."""
+        return np.delete(self.system.initial_y(), self.i_phi)
+
+    def scale(self, machin: float | None) -> float:
+        return self.rod_frame.scale(machin)
+
+    def velocity(self, z, base, machin: float | None = None):
+        """``dz/dt`` (turning frame) and the :class:`ForceInfo` at ``z``."""
+        from flagwrap.system.rotating import subtract_rotation
+
+        s = self.system
+        y = self.full(z)
+        info = s.forces(y, base)
+        f = s.apply_mobility(y, info.G)
+        f *= self.scale(machin)
+        subtract_rotation(f, s, info, self.omega, self.axis, self.rod_frame._A)
+        return np.delete(f, self.i_phi), info
+
+    def jacobian(self, z, base, machin: float | None = None, info=None) -> np.ndarray:
+        """``d(dz/dt)/dz`` (n, n), dense (class docstring)."""
+        s = self.system
+        y = self.full(z)
+        nr, n = self.n_rod, self.n
+        so = s.sl_order
+        rod_cols = np.arange(nr)  # in y, the rod's unknowns before the motor angle
+        h = s.fd_step
+        # d G / d order (every row) and d G_order / d rod (the order's rows)
+        dG_do = np.empty((s.ny, so.stop - so.start))
+        dGo_dr = np.empty((so.stop - so.start, nr))
+        yp = y.copy()
+        for j, k in enumerate(range(so.start, so.stop)):
+            yp[k] = y[k] + h
+            gp = s.forces(yp, base).G
+            yp[k] = y[k] - h
+            gm = s.forces(yp, base).G
+            yp[k] = y[k]
+            dG_do[:, j] = (gp - gm) / (2.0 * h)
+        for j, k in enumerate(rod_cols):
+            yp[k] = y[k] + h
+            gp = s.forces(yp, base).G[so]
+            yp[k] = y[k] - h
+            gm = s.forces(yp, base).G[so]
+            yp[k] = y[k]
+            dGo_dr[:, j] = (gp - gm) / (2.0 * h)
+        info = s.forces(y, base)  # the rest at y's own order parameters, for the rod's block
+        J = np.empty((n, n))
+        J[:nr, :nr] = self.rod_frame.jacobian(z[:nr], base, machin, info)
+        c = self.scale(machin)
+        Mxx, mt = s.mobility_blocks(y)
+        n3 = self.n3
+        J[:n3, nr:] = c * (Mxx @ dG_do[:n3])
+        J[n3:nr, nr:] = c * (mt[:, None] * dG_do[n3:nr])
+        m = c * s.order_mobility[:, None]
+        J[nr:, :nr] = m * dGo_dr
+        J[nr:, nr:] = m * dG_do[so]
+        return J
