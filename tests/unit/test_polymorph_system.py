@@ -644,3 +644,25 @@ def test_polymorph_frame_jacobian_is_the_derivative_of_its_velocity():
         scale = np.abs(Jfd[r, c]).max()
         assert scale > 0
         assert np.abs(J[r, c] - Jfd[r, c]).max() < 1e-7 * scale
+
+
+def test_stability_starts_from_the_relaxed_order():
+    """With tilted wells (``maxwell_torque``) the configured state is not at rest: the frame's
+    ``initial_state`` relaxes it first. At rest the rod is stress-free for any uniform phi,
+    so phi is the tilted well's root, ``W (phi^3 - phi) = h`` with ``h = -N_M Delta / 2``
+    (P2), to 1e-6; Newton then converges from it at a low M."""
+    from scipy.optimize import brentq
+
+    from flagwrap.stability.steady import newton
+    from flagwrap.stability.threshold import make_frame
+
+    fr = make_frame(_tiny_stability_cfg("maxwell_torque = 1e-5\n"), -1.0)
+    z, base = fr.initial_state()
+    m = fr.system.model
+    h = m.tilt(0.0)
+    assert abs(h) > 0.01 * m.barrier  # a real tilt
+    root = brentq(lambda p: m.barrier * (p**3 - p) - h, -1.6, -0.58)
+    phi = z[fr.n_rod:]
+    assert np.abs(phi - root).max() < 1e-6 and abs(root + 1.0) > 1e-3
+    st = newton(fr, 50.0, z, base)
+    assert st.converged

@@ -128,11 +128,13 @@ def newton(frame, machin: float, z0: np.ndarray, base0, step_tol: float = 1e-10,
 
 
 def initial_guess(frame):
-    """The rest shape in the turning frame: ``(z, base)``."""
+    """The rest shape in the turning frame: ``(z, base)`` (or the frame's own
+    ``initial_state``)."""
+    own = getattr(frame, "initial_state", None)  # a frame with its own start (the polymorph's)
+    if own is not None:
+        return own()
     s = frame.system
-    own = getattr(frame, "initial_z", None)  # a frame whose unknowns are not y's first n
-    z = own() if own is not None else s.initial_y()[:frame.n].copy()
-    return z, s.frames0.copy()
+    return s.initial_y()[:frame.n].copy(), s.frames0.copy()
 
 
 def extrapolate(frame, a: SteadyState, b: SteadyState, machin: float) -> np.ndarray:

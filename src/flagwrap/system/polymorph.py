@@ -501,9 +501,28 @@ class PolymorphFrame:
         """The lab state vector at ``phi = 0`` (where both frames coincide)."""
         return np.insert(np.asarray(z, float), self.i_phi, 0.0)
 
-    def initial_z(self) -> np.ndarray:
-        """The configured initial state without the motor angle."""
-        return np.delete(self.system.initial_y(), self.i_phi)
+    def initial_state(self, t_max: float = 5000.0, tol: float = 1e-9):
+        """``(z, base)``: the filament at rest with its order parameters relaxed, the start of
+        a branch. The configured initial state is not a fixed point where the wells are
+        tilted (``maxwell_torque``) or the rod pushes on ``phi``: ``phi`` settles off +-1, the
+        rest shape follows, and the rod moves by up to ~0.1 L (measured on the E. coli
+        case), outside Newton's basin. So the system is first relaxed in time with the motor
+        still (ROS34PW2 at tol 1e-8) until no unknown moves faster than ``tol`` per unit
+        time, or ``t_max``."""
+        from flagwrap.integrators import REGISTRY
+
+        s = self.system
+        integ = REGISTRY["ros34pw2"](1e-8)
+        y = s.initial_y()
+        info = s.forces(y, s.frames0.copy())
+        t, h = 0.0, 1e-3
+        while t < t_max and np.abs(s.velocity(y, info, 0.0)).max() > tol:
+            r = integ.step(s, y, info.frames, info, h, 0.0)
+            if r.accepted:
+                t += h
+                y, info = r.y, r.info
+            h = min(r.h_next, t_max - t) if t < t_max else r.h_next
+        return np.delete(y, self.i_phi), info.frames
 
     def scale(self, machin: float | None) -> float:
         return self.rod_frame.scale(machin)
