@@ -335,8 +335,8 @@ def test_polymorph_summary_reads_a_known_front(tmp_path):
 
 def test_cli_analyze_reports_the_polymorph_and_stability_refuses_a_free_one(tmp_path, capsys):
     """``flagwrap analyze`` prints the polymorph line of a polymorph run (and none for a
-    fixed-shape one); ``flagwrap stability`` refuses a polymorph config on a free cell (and
-    its ``--far``) by name, exit 2,
+    fixed-shape one); ``flagwrap stability`` refuses a polymorph config on a free cell by
+    name, exit 2,
     before any work."""
     from flagwrap.cli.main import main
 
@@ -352,7 +352,7 @@ def test_cli_analyze_reports_the_polymorph_and_stability_refuses_a_free_one(tmp_
         text = capsys.readouterr().out
         assert (expect in text) if expect else ("polymorph" not in text)
     for extra, args in (("[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n",
-                         []), (body, ["--far"])):
+                         []),):
         cfg.write_text(tiny_toml() + POLY + extra)
         assert main(["stability", str(cfg), "--no-progress"] + args) == 2
         err = capsys.readouterr().err
@@ -666,3 +666,24 @@ def test_stability_starts_from_the_relaxed_order():
     assert np.abs(phi - root).max() < 1e-6 and abs(root + 1.0) > 1e-3
     st = newton(fr, 50.0, z, base)
     assert st.converged
+
+
+@pytest.mark.slow
+def test_far_diagram_of_a_one_state_filament_is_the_fixed_rods():
+    """``flagwrap stability --far`` with the order block: a one-state filament's diagram is
+    the fixed rod's (the same Hopf to 1e-8, the same far states to 1e-6 in M and tip, lost
+    below the same M), the order modes being decoupled; two forms answer too, with stable
+    far states (43 s and 23 s here)."""
+    from flagwrap.stability.bifurcation import bifurcation_diagram
+
+    kw = dict(cycles=(), m_hi=1500.0, settle=10.0)
+    plain = bifurcation_diagram(_cfg(), **kw)
+    one = bifurcation_diagram(_cfg(POLY + "polymorph_b = 'ecoli_normal'\n"), **kw)
+    assert one.machin_hopf == pytest.approx(plain.machin_hopf, rel=1e-8)
+    assert len(one.far) == len(plain.far) > 0
+    for a, b in zip(one.far, plain.far):
+        assert a.machin == pytest.approx(b.machin, rel=1e-6)
+        assert a.tip_z == pytest.approx(b.tip_z, abs=1e-6)
+    assert one.far_lost_below == pytest.approx(plain.far_lost_below, rel=1e-6)
+    two = bifurcation_diagram(_cfg(POLY), **kw)
+    assert two.far and all(p.leading.real < 0 for p in two.far)

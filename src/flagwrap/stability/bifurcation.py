@@ -239,10 +239,10 @@ def relax(config, frame, z, base, machin: float, turns: float, direction: str) -
     from flagwrap.params import Phase
 
     cfg = frame_config(config, machin, (Phase(direction, turns),))
-    tr = _run(cfg, np.concatenate([z, [0.0]]), base)
+    tr = _run(cfg, frame.full(z), base)
     if not tr.ok:
         raise NewtonFailure(f"the relaxation run at M = {machin:.6g} stopped: {tr.message}", None)
-    return newton(frame, machin, tr.final_y[:-1].copy(), tr.final_frames)
+    return newton(frame, machin, frame.reduce(tr.final_y), tr.final_frames)
 
 
 # --------------------------------------------------------------------------------------------
@@ -353,10 +353,10 @@ def far_state_from_reversal(config, frame, machin: float, direction: str, settle
                                f"from (Newton continuation lost it)") from None
     # both frames are the lab's at phi = 0: the same unknowns
     tr = _run(frame_config(config, machin, (Phase(direction, settle),)),
-              np.concatenate([first.z, [0.0]]), first.base)
+              frame.full(first.z), first.base)
     if not tr.ok:
         raise FarStateNotFound(f"{what} stopped: {tr.message}")
-    z = tr.final_y[:-1].copy()
+    z = frame.reduce(tr.final_y)
     try:
         st = newton(frame, machin, z, tr.final_frames)
     except NewtonFailure as exc:
@@ -384,9 +384,11 @@ def read_far_from(config, path) -> dict:
         out = {"x": np.asarray(ds["position"].values[-1], float) / rcfg.scales.length,
                "theta": np.asarray(ds["twist_angle"].values[-1], float),
                "phi": float(ds["motor_angle"].values[-1]), "machin": float(rcfg.machin)}
+        if "polymorph_order" in ds.variables:
+            out["order"] = np.asarray(ds["polymorph_order"].values[-1], float)
     finally:
         ds.close()
-    parts = ("filament", "body", "contact", "clamp", "joint", "flagella", "walls")
+    parts = ("filament", "body", "contact", "clamp", "joint", "flagella", "walls", "polymorph")
     differ = [k for k in parts if getattr(rcfg, k) != getattr(config, k)]
     if differ:
         raise UserInputError(f"--far-from {path}: a run of another helix or system than "
@@ -407,9 +409,11 @@ def far_state_from_run(config, frame, path, last: dict, direction: str, settle: 
         raise UserInputError(f"--far-from {path}: its M = {m:.5g} lies outside the diagram's "
                              f"range [{lo:.5g}, {hi:.5g}] (--m-lo, --m-hi)")
     # the lab beads turned back by the motor angle (R^T x, row by row): the turning frame
-    y = frame.system.pack(last["x"] @ rotation(frame.axis, last["phi"]), last["theta"], 0.0)
+    own = {"order": last["order"]} if "order" in last else {}  # a polymorphic filament's
+    y = frame.system.pack(last["x"] @ rotation(frame.axis, last["phi"]), last["theta"], 0.0,
+                          **own)
     try:
-        return relax(config, frame, y[:-1], None, m, settle, direction)
+        return relax(config, frame, frame.reduce(y), None, m, settle, direction)
     except NewtonFailure as exc:
         raise FarStateNotFound(f"the last frame of {path} relaxed {settle:g} turns at M = "
                                f"{m:.5g} does not reach a steady state ({exc})") from None
@@ -426,7 +430,7 @@ def hopf_cycle(config, frame, whirl: SteadyState, mode: np.ndarray, direction: s
     cfg = frame_config(config, whirl.machin, (Phase(direction, turns),))
     cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, save_every=0.05))
     z0 = retract(frame, whirl.z, kick * mode)
-    tr = _run(cfg, np.concatenate([z0, [0.0]]), whirl.base)
+    tr = _run(cfg, frame.full(z0), whirl.base)
     A = tr.arrays()
     t = A["t"]
     last = t >= t[-1] - 2 * math.pi * window
@@ -489,10 +493,6 @@ def bifurcation_diagram(config, direction: str = "cw", m_far: float | None = Non
     check_diagram_options(m_far, m_lo, m_hi, settle, factor, cycles)
     if direction not in DIRECTIONS:
         raise UserInputError(f"direction must be 'cw' or 'ccw', got {direction!r}")
-    if config.polymorph.enabled:
-        raise UserInputError("flagwrap stability --far: a polymorphic filament's far branch is "
-                             "not followed yet (its whirl's M_c is: drop --far); set "
-                             "polymorph.enabled = false for the fixed shape of polymorph_a")
     if config.body.free:
         raise UserInputError("flagwrap stability --diagram: a free-swimming cell's far states "
                              "are not followed (only a held cell's or the rig's): set "

@@ -501,6 +501,10 @@ class PolymorphFrame:
         """The lab state vector at ``phi = 0`` (where both frames coincide)."""
         return np.insert(np.asarray(z, float), self.i_phi, 0.0)
 
+    def reduce(self, y) -> np.ndarray:
+        """The unknowns ``z`` of a state ``y``: :meth:`full`'s inverse."""
+        return np.delete(np.asarray(y, float), self.i_phi)
+
     def initial_state(self, t_max: float = 5000.0, tol: float = 1e-9):
         """``(z, base)``: the filament at rest with its order parameters relaxed, the start of
         a branch. The configured initial state is not a fixed point where the wells are

@@ -137,6 +137,10 @@ class RotatingFrame:
         y[-1] = 0.0
         return y
 
+    def reduce(self, y) -> np.ndarray:
+        """The unknowns ``z`` of a lab-layout state ``y`` (a copy): :meth:`full`'s inverse."""
+        return np.array(y[:self.n], float)
+
     def scale(self, machin: float | None) -> float:
         return 1.0 if machin is None else self.system.machin / float(machin)
 
