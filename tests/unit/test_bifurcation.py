@@ -207,3 +207,17 @@ def test_sweep_far_adds_each_helix_fold(tiny, capsys):
     # --sweep --far refuses the options of one helix's diagram
     assert main(["stability", str(spec), "--sweep", "--far", "--diagram", "x.png"]) == 2
     assert "apply to one helix" in capsys.readouterr().err
+
+
+def test_frame_config_takes_a_config_whose_speed_is_a_frequency():
+    """A config that gives the reference speed in Hz (the bacteria's) is stepped at the
+    diagram's M: its frequency gives way (the two are exclusive; before, every --far on such
+    a config stopped with 'give exactly one of frequency or machin')."""
+    from flagwrap.io.config import config_from_dict, tomllib
+    from flagwrap.params import Phase
+    from flagwrap.stability.bifurcation import frame_config
+
+    cfg = config_from_dict(tomllib.loads(tiny_toml().replace("machin = 100", "frequency = 0.05")))
+    out = frame_config(cfg, 1234.0, (Phase("cw", 2.0),))
+    assert out.motor.frequency is None and out.machin == pytest.approx(1234.0)
+    assert out.numerics.frame == "rotating"

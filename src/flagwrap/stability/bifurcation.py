@@ -215,8 +215,10 @@ def _fold_machin(points, k) -> float:
 
 def frame_config(config, machin: float, protocol):
     """``config`` at ``machin``, stepped in the turning frame with ``protocol`` (phases)."""
+    # the reference speed given as M (a config that gives it as a frequency in Hz gives it up)
     return config.replace(
-        motor=dataclasses.replace(config.motor, machin=float(machin), protocol=tuple(protocol)),
+        motor=dataclasses.replace(config.motor, machin=float(machin), frequency=None,
+                                  protocol=tuple(protocol)),
         numerics=dataclasses.replace(config.numerics, frame="rotating"))
 
 
