@@ -514,21 +514,19 @@ def make_system(config):
     """The config's system, a :class:`RodSystem`: transformed to the turning frame when
     ``numerics.frame = "rotating"`` (:class:`flagwrap.system.rotating.RotatingSystem`), or
     given a free body (``body.motion = "free"``: :class:`flagwrap.system.swimmer.
-    SwimmerSystem`); either is a ``RodSystem`` over the same parts, not a wrapper."""
+    SwimmerSystem`); either is a ``RodSystem`` over the same parts, not a wrapper. A
+    ``[polymorph]`` adds its order block to whichever it is
+    (:class:`flagwrap.system.polymorph.PolymorphSystem`)."""
     if config.body.free:
         from flagwrap.system.swimmer import make_swimmer
 
         system = make_swimmer(config)
-        if config.polymorph.enabled:
-            from flagwrap.system.polymorph import PolymorphSystem
-
-            system = PolymorphSystem(system)
-        return system
-    system = RodSystem(config)
-    if config.numerics.frame == "rotating":
+    elif config.numerics.frame == "rotating":
         from flagwrap.system.rotating import RotatingSystem
 
-        system = RotatingSystem(system)
+        system = RotatingSystem(RodSystem(config))
+    else:
+        system = RodSystem(config)
     if config.polymorph.enabled:
         from flagwrap.system.polymorph import PolymorphSystem
 

@@ -157,12 +157,14 @@ class ElasticForces:
     def set_order(self, order) -> None:
         """Polymorphic filaments' rests at the order parameters ``order`` (every bead of the
         run, one frame's: ``a + (phi + 1)/2 (b - a)``, as the simulator's ``set_rest``)."""
+        from flagwrap.elasticity.polymorph import interpolate_rest
+
         order = np.asarray(order, float)
         start = 0
         for p, (ka, kb, ma, mb) in zip(self.parts, self._pairs):
-            t = 0.5 * (order[start:start + p.N] + 1.0)
-            p.rest.kbar[:] = ka + t[:, None] * (kb - ka)
-            p.rest.mbar[:] = ma + t * (mb - ma)
+            phi = order[start:start + p.N]
+            p.rest.kbar[:] = interpolate_rest(ka, kb, phi)
+            p.rest.mbar[:] = interpolate_rest(ma, mb, phi)
             start += p.N
 
     def rest_twist(self, filament: int = 0) -> np.ndarray:

@@ -27,12 +27,25 @@ def transforming_vertices(config) -> np.ndarray:
 
 def polymorph_summaries(ds) -> list | None:
     """:func:`polymorph_summary` of every flagellum of the run, or ``None`` without the
-    polymorph state."""
+    polymorph state. What all flagella share (the config, the transforming vertices, the
+    two forms' heights) is computed once."""
     if "polymorph_order" not in ds.variables:
         return None
-    from flagwrap.io.runfile import filament_slices
+    from flagwrap.io.runfile import config_of, filament_slices
+    from flagwrap.system.polymorph import polymorph_geometry
 
-    return [polymorph_summary(ds, k) for k in range(len(filament_slices(ds)))]
+    cfg = config_of(ds)
+    mask = transforming_vertices(cfg)
+    fil = cfg.filament
+    RB, PB, _ = polymorph_geometry(cfg)
+    common = {"height_a": -fil.pitch / np.hypot(2 * np.pi * fil.helix_radius, fil.pitch),
+              "height_b": -PB / np.hypot(2 * np.pi * RB, PB),
+              "polymorph_a": ds.attrs.get("polymorph_a", cfg.polymorph.polymorph_a),
+              "polymorph_b": ds.attrs.get("polymorph_b", cfg.polymorph.polymorph_b)}
+    order, x0 = ds["polymorph_order"].values, ds["position"].values[0]
+    turns, t = ds["turns"].values, ds["time"].values
+    return [_summary(order[:, sl], mask[sl], x0[sl], turns, t, common)
+            for sl in filament_slices(ds)]
 
 
 def polymorph_summary(ds, filament: int = 0) -> dict | None:
@@ -54,30 +67,19 @@ def polymorph_summary(ds, filament: int = 0) -> dict | None:
       the free end) cannot tell from a buckle;
     * ``fraction_series`` (time,).
     """
-    if "polymorph_order" not in ds.variables:
-        return None
-    from flagwrap.io.runfile import config_of, filament_slices
+    summaries = polymorph_summaries(ds)
+    return None if summaries is None else summaries[filament]
 
-    cfg = config_of(ds)
-    sl = filament_slices(ds)[filament]
-    order = ds["polymorph_order"].values[:, sl]
-    mask = transforming_vertices(cfg)[sl]
-    x0 = ds["position"].values[0][sl]
+
+def _summary(order, mask, x0, turns, t, common) -> dict:
+    """One flagellum's :func:`polymorph_summary` from its order (time, N), transforming
+    vertices (N,), first-frame beads (N, 3), and what all flagella share."""
     # contour distance from the filament's first bead (the motor's end of its chain)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x0, axis=0), axis=1))])
     phi, sm = order[:, mask], s[mask]
     inb = phi > 0.0
     frac = inb.mean(axis=1) if mask.any() else np.zeros(len(order))
-    turns = ds["turns"].values
-    t = ds["time"].values
-    from flagwrap.system.polymorph import polymorph_geometry
-
-    fil = cfg.filament
-    RB, PB, _ = polymorph_geometry(cfg)
-    out = {"height_a": -fil.pitch / np.hypot(2 * np.pi * fil.helix_radius, fil.pitch),
-           "height_b": -PB / np.hypot(2 * np.pi * RB, PB),
-           "polymorph_a": ds.attrs.get("polymorph_a", cfg.polymorph.polymorph_a),
-           "polymorph_b": ds.attrs.get("polymorph_b", cfg.polymorph.polymorph_b),
+    out = {**common,
            "fraction_b_final": float(frac[-1]), "fraction_b_max": float(frac.max()),
            "start_turns": None, "start_time_s": None, "start_position_m": None,
            "start_fraction": None, "starts_at": None, "front_speed_m_s": None,

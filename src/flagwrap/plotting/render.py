@@ -272,6 +272,13 @@ POLYMORPH_B_RGB = np.array([0.90, 0.45, 0.10])
 BODY_RGB = np.array([0.62, 0.64, 0.66])
 
 
+def polymorph_mix(phi, a_rgb=TUBE_RGB, b_rgb=POLYMORPH_B_RGB) -> np.ndarray:
+    """Colours (n, 3) of order parameters ``phi`` (n,): clipped to [-1, 1], ``a_rgb`` at -1
+    mixed linearly to ``b_rgb`` at +1."""
+    w = 0.5 * (np.clip(np.asarray(phi, float), -1.0, 1.0) + 1.0)
+    return (1.0 - w)[:, None] * np.asarray(a_rgb)[None, :] + w[:, None] * np.asarray(b_rgb)[None, :]
+
+
 def polymorph_rgb(order, n_segments: int, n_faces_per_ring: int, a_rgb=TUBE_RGB,
                   b_rgb=POLYMORPH_B_RGB) -> np.ndarray:
     """Face colours (Q, 3) of one tube from the order parameter per bead (N,): each of the
@@ -281,8 +288,7 @@ def polymorph_rgb(order, n_segments: int, n_faces_per_ring: int, a_rgb=TUBE_RGB,
     order = np.asarray(order, float)
     n = len(order)
     u = (np.arange(n_segments) + 0.5) * (n - 1) / n_segments  # segment middles, in beads
-    w = 0.5 * (np.clip(np.interp(u, np.arange(n), order), -1.0, 1.0) + 1.0)
-    rgb = (1.0 - w)[:, None] * a_rgb[None, :] + w[:, None] * b_rgb[None, :]
+    rgb = polymorph_mix(np.interp(u, np.arange(n), order), a_rgb, b_rgb)
     return np.repeat(rgb, n_faces_per_ring, axis=0)
 BODY_ALPHA = 0.4
 
@@ -358,9 +364,7 @@ class Renderer:
                 o = np.asarray(order)[sl]
                 groups.append((quads, qn, polymorph_rgb(o, len(quads) // self.sides,
                                                         self.sides, a_rgb=rgb), 1.0))
-                ends = np.clip(o[[0, -1]], -1.0, 1.0) * 0.5 + 0.5
-                cap_rgb = (1 - ends)[:, None] * rgb + ends[:, None] * POLYMORPH_B_RGB
-                groups.append((caps, cn, cap_rgb, 1.0))
+                groups.append((caps, cn, polymorph_mix(o[[0, -1]], rgb), 1.0))
                 continue
             groups.append((quads, qn, rgb, 1.0))
             groups.append((caps, cn, rgb, 1.0))

@@ -64,9 +64,9 @@ def polymorph_geometry(config):
     ``R_B = R (R_b / R_a)``, ``P_B = P (P_b / P_a)``, the handedness flipped when the two
     library forms differ in it. A filament built with A's library geometry gets B's library
     geometry exactly; a scaled rig (e.g. the paper's macroscopic helix) keeps the ratios."""
-    from flagwrap.elasticity.polymorph_library import default_library
+    from flagwrap.params import _polymorph_library
 
-    lib = default_library()
+    lib = _polymorph_library()  # parsed once per process
     pm, fil = config.polymorph, config.filament
     a, b = lib.polymorph(pm.polymorph_a), lib.polymorph(pm.polymorph_b)
     hand = fil.handedness
@@ -189,8 +189,7 @@ class PolymorphSystem(RodSystem):
         self.parts = rod.parts = parts
         #: ``d kbar/dphi``, ``d mbar/dphi`` (:func:`~flagwrap.elasticity.polymorph.rest_derivative`)
         self._kbar_ba, self._mbar_ba = self.kbar_b - self.kbar_a, self.mbar_b - self.mbar_a
-        self.dkbar = 0.5 * (self.kbar_b - self.kbar_a)
-        self.dmbar = 0.5 * (self.mbar_b - self.mbar_a)
+        self.dkbar, self.dmbar = 0.5 * self._kbar_ba, 0.5 * self._mbar_ba
         self._cbend = cat([p.rest.cbend for p in parts])
         self._ctwist = cat([p.rest.ctwist for p in parts])
         # d2 E_el / dphi2 at each vertex, constant: the energy is quadratic in the rest values
@@ -525,8 +524,8 @@ class PolymorphFrame:
             if r.accepted:
                 t += h
                 y, info = r.y, r.info
-            h = min(r.h_next, t_max - t) if t < t_max else r.h_next
-        return np.delete(y, self.i_phi), info.frames
+            h = min(r.h_next, t_max - t)
+        return self.reduce(y), info.frames
 
     def scale(self, machin: float | None) -> float:
         return self.rod_frame.scale(machin)
@@ -541,7 +540,7 @@ class PolymorphFrame:
         f = s.apply_mobility(y, info.G)
         f *= self.scale(machin)
         subtract_rotation(f, s, info, self.omega, self.axis, self.rod_frame._A)
-        return np.delete(f, self.i_phi), info
+        return self.reduce(f), info
 
     def jacobian(self, z, base, machin: float | None = None, info=None) -> np.ndarray:
         """``d(dz/dt)/dz`` (n, n), dense (class docstring)."""
@@ -549,26 +548,20 @@ class PolymorphFrame:
         y = self.full(z)
         nr, n = self.n_rod, self.n
         so = s.sl_order
-        rod_cols = np.arange(nr)  # in y, the rod's unknowns before the motor angle
         h = s.fd_step
-        # d G / d order (every row) and d G_order / d rod (the order's rows)
-        dG_do = np.empty((s.ny, so.stop - so.start))
-        dGo_dr = np.empty((so.stop - so.start, nr))
+        # dG/dz by central differences over every unknown but the motor angle (the rod's
+        # unknowns come before it, the order block after): the cross blocks are read from it
+        cols = np.delete(np.arange(s.ny), self.i_phi)
+        dG = np.empty((s.ny, n))
         yp = y.copy()
-        for j, k in enumerate(range(so.start, so.stop)):
+        for j, k in enumerate(cols):
             yp[k] = y[k] + h
             gp = s.forces(yp, base).G
             yp[k] = y[k] - h
             gm = s.forces(yp, base).G
             yp[k] = y[k]
-            dG_do[:, j] = (gp - gm) / (2.0 * h)
-        for j, k in enumerate(rod_cols):
-            yp[k] = y[k] + h
-            gp = s.forces(yp, base).G[so]
-            yp[k] = y[k] - h
-            gm = s.forces(yp, base).G[so]
-            yp[k] = y[k]
-            dGo_dr[:, j] = (gp - gm) / (2.0 * h)
+            dG[:, j] = (gp - gm) / (2.0 * h)
+        dG_do, dGo_dr = dG[:, nr:], dG[so, :nr]  # d G / d order, d G_order / d rod
         info = s.forces(y, base)  # the rest at y's own order parameters, for the rod's block
         J = np.empty((n, n))
         J[:nr, :nr] = self.rod_frame.jacobian(z[:nr], base, machin, info)
