@@ -1,0 +1,195 @@
+"""A circular tube, straight or with a constriction, as a no-slip surface of blobs
+(docs/confinement.md, "Tubes").
+
+Geometry. The tube's axis is the line through ``center`` along the unit vector ``axis``; ``s``
+is the signed distance along it from ``center``, the tube spans ``|s| <= length/2``. Its wall
+radius is
+
+    R(s) = R_t - (R_t - R_c) (1 + cos(2 pi (s - s_c) / L_c)) / 2   for |s - s_c| < L_c / 2,
+    R(s) = R_t                                                      elsewhere,
+
+a constriction of radius ``R_c`` and length ``L_c`` centred at ``s_c`` (a cosine bump: radius
+and slope continuous), or a straight tube without one. Ends are open (a channel between two
+reservoirs) or closed by flat discs (``closed=True``: a sealed test cell, whose far field is
+the infinite tube's when the ends are far from what moves inside; the wall-drag checks use it).
+
+Blobs. Rings of blobs about ``spacing`` apart along the wall's meridian and around each ring
+(successive rings turned by half a step), placed ``BLOB_INSET`` blob radii outside the
+surface (:meth:`Tube.blob_offset`, as the cell body's shell is inset by as much). The blobs
+hold the wall still: their forces solve ``M_bb lambda = -u`` like a held body's
+(:class:`flagwrap.body.fixed_mobility.FixedBodyMobility`). Unlike a body's shell, a tube has
+fluid on both sides, and a shell of blobs is a porous wall: fluid that the inside pushes
+leaks through the gaps. With blob radii of half the spacing (the body's rule) a sphere on a
+closed tube's axis feels 2-16 % too little drag at a/R_t = 0.1-0.6 (spacing 0.1 R_t), and the
+longer the tube, the less (more wall to leak through); with radii equal to the spacing
+(``BLOB_RADIUS_RATIO``) the error is below 0.6 % (docs/confinement.md, "Tubes", the table).
+
+Distance. ``gap(x)`` is a point's distance to the wall on the fluid's side (positive inside),
+``(R(s) - r) / sqrt(1 + R'(s)^2)``: exact for the straight tube, first order in the slope's
+change across the gap for the constriction.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from flagwrap.body.multiblob import BLOB_INSET
+from flagwrap.errors import UserInputError
+
+#: blob radius over blob spacing of a tube's shell: 1 (overlapping blobs) where a body's is 1/2,
+#: since a thin shell with fluid on both sides leaks through its gaps (module docstring)
+BLOB_RADIUS_RATIO = 1.0
+
+
+@dataclass(frozen=True)
+class Tube:
+    """A tube in one unit of length (core or SI; the caller's). ``constriction_radius`` None:
+    straight."""
+
+    radius: float
+    length: float
+    center: tuple = (0.0, 0.0, 0.0)
+    axis: tuple = (0.0, 0.0, 1.0)
+    constriction_radius: float | None = None
+    constriction_length: float = 0.0
+    constriction_center: float = 0.0
+    closed: bool = False
+
+    def __post_init__(self):
+        if not (math.isfinite(self.radius) and self.radius > 0):
+            raise UserInputError(f"tube.radius must be > 0, got {self.radius!r}")
+        if not (math.isfinite(self.length) and self.length > 0):
+            raise UserInputError(f"tube.length must be > 0, got {self.length!r}")
+        ax = np.asarray(self.axis, float)
+        if ax.shape != (3,) or not np.all(np.isfinite(ax)) or np.linalg.norm(ax) == 0:
+            raise UserInputError(f"tube.axis must be three finite numbers, not all zero, got "
+                                 f"{self.axis!r}")
+        c = np.asarray(self.center, float)
+        if c.shape != (3,) or not np.all(np.isfinite(c)):
+            raise UserInputError(f"tube.center must be three finite numbers, got {self.center!r}")
+        object.__setattr__(self, "axis", tuple(float(v) for v in ax / np.linalg.norm(ax)))
+        object.__setattr__(self, "center", tuple(float(v) for v in c))
+        rc = self.constriction_radius
+        if rc is not None:
+            if not (math.isfinite(rc) and 0 < rc < self.radius):
+                raise UserInputError(f"tube.constriction_radius must be in (0, tube.radius = "
+                                     f"{self.radius:g}), got {rc!r}")
+            lc, sc = self.constriction_length, self.constriction_center
+            if not (math.isfinite(lc) and 0 < lc <= self.length):
+                raise UserInputError(f"tube.constriction_length must be in (0, tube.length = "
+                                     f"{self.length:g}], got {lc!r}")
+            if not (math.isfinite(sc) and abs(sc) + lc / 2 <= self.length / 2 * (1 + 1e-12)):
+                raise UserInputError(
+                    f"tube.constriction_center must keep the constriction inside the tube: "
+                    f"|center| + length/2 <= {self.length / 2:g}, got {sc!r} (length {lc:g})")
+
+    # --- the surface --------------------------------------------------------------------
+    def wall_radius(self, s):
+        """``R(s)`` (module docstring)."""
+        s = np.asarray(s, float)
+        R = np.full(s.shape, float(self.radius))
+        if self.constriction_radius is not None:
+            u = (s - self.constriction_center) / self.constriction_length
+            inside = np.abs(u) < 0.5
+            R[inside] -= (self.radius - self.constriction_radius) * 0.5 * (
+                1 + np.cos(2 * np.pi * u[inside]))
+        return R
+
+    def wall_slope(self, s):
+        """``dR/ds``."""
+        s = np.asarray(s, float)
+        d = np.zeros(s.shape)
+        if self.constriction_radius is not None:
+            lc = self.constriction_length
+            u = (s - self.constriction_center) / lc
+            inside = np.abs(u) < 0.5
+            d[inside] = (self.radius - self.constriction_radius) * np.pi / lc * np.sin(
+                2 * np.pi * u[inside])
+        return d
+
+    @property
+    def narrowest(self) -> float:
+        return self.radius if self.constriction_radius is None else self.constriction_radius
+
+    def frame(self) -> np.ndarray:
+        """``(e1, e2, axis)`` as rows: a right-handed frame with the tube's axis last."""
+        a = np.asarray(self.axis)
+        t = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        e1 = t - (t @ a) * a
+        e1 /= np.linalg.norm(e1)
+        return np.array([e1, np.cross(a, e1), a])
+
+    def cylindrical(self, x):
+        """``(s, r)`` of points ``x`` (..., 3): along the axis from ``center``, and from it."""
+        d = np.asarray(x, float) - np.asarray(self.center)
+        s = d @ np.asarray(self.axis)
+        r = np.linalg.norm(d - s[..., None] * np.asarray(self.axis), axis=-1)
+        return s, r
+
+    def gap(self, x):
+        """Distance of points ``x`` (..., 3) from the wall on the fluid's side (module
+        docstring): positive inside the tube, negative across its wall. Past the open ends a
+        point is outside the tube (``+inf``: nothing to meet)."""
+        s, r = self.cylindrical(x)
+        g = (self.wall_radius(s) - r) / np.sqrt(1.0 + self.wall_slope(s) ** 2)
+        return np.where(np.abs(s) <= 0.5 * self.length, g, np.inf)
+
+    # --- blobs ---------------------------------------------------------------------------
+    @staticmethod
+    def blob_offset(blob_radius: float) -> float:
+        """How far outside the surface the blob centres sit: ``BLOB_INSET`` blob radii."""
+        return BLOB_INSET * blob_radius
+
+    def blob_shell(self, spacing: float, blob_radius: float) -> np.ndarray:
+        """Blob centres (n, 3) (module docstring): rings ``spacing`` apart along the meridian
+        of the surface offset ``BLOB_INSET * blob_radius`` outward, ``spacing`` apart around;
+        closed ends add flat discs of concentric rings."""
+        if not (math.isfinite(spacing) and 0 < spacing < self.narrowest):
+            raise UserInputError(f"tube blob spacing must be in (0, {self.narrowest:g}) (the "
+                                 f"narrowest radius), got {spacing!r}")
+        off = self.blob_offset(blob_radius)
+        # the meridian r = R(s) + off, sampled finely, cut at equal arc length
+        half = 0.5 * self.length
+        ss = np.linspace(-half, half, max(2001, int(40 * self.length / spacing)))
+        rr = self.wall_radius(ss) + off * np.sqrt(1.0 + self.wall_slope(ss) ** 2)
+        arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(ss), np.diff(rr)))])
+        n_rings = max(2, int(round(arc[-1] / spacing)) + 1)
+        at = np.linspace(0.0, arc[-1], n_rings)
+        s_r, r_r = np.interp(at, arc, ss), np.interp(at, arc, rr)
+        rings = [(s, r, 0.5 * k) for k, (s, r) in enumerate(zip(s_r, r_r))]
+        if self.closed:  # discs at both ends, inside the last ring
+            for s_end, r_end in ((s_r[0], r_r[0]), (s_r[-1], r_r[-1])):
+                s_disc = s_end - np.sign(s_end) * 0.0
+                n_disc = int(round(r_end / spacing))
+                for k in range(1, n_disc):
+                    rings.append((s_disc, r_end * k / n_disc, 0.5 * k))
+                rings.append((s_disc, 0.0, 0.0))
+        e1, e2, a = self.frame()
+        pts = []
+        for s, r, phase in rings:
+            m = 1 if r == 0.0 else max(3, int(round(2 * math.pi * r / spacing)))
+            ang = 2 * math.pi * (np.arange(m) + phase) / m
+            pts.append(s * a + r * (np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2))
+        return np.asarray(self.center) + np.concatenate(pts)
+
+
+def rigid_body_drag(boundary_blobs, boundary_radii, body_blobs, body_radii, velocity,
+                    solver: str = "auto") -> np.ndarray:
+    """Force (3,) the fluid exerts on a rigid blob body translating at ``velocity`` (3,)
+    without rotating, beside a still blob boundary (a tube), viscosity 1: the blob forces
+    solve ``M lambda = u`` with ``u`` the body's velocity on its blobs and 0 on the
+    boundary's (Balboa Usabiaga et al., J. Chem. Phys. 146, 134104 (2017)), and the drag is
+    ``-sum lambda`` over the body's blobs. The check of the tube against Haberman & Sayre's
+    factor (tests/unit/test_tube.py)."""
+    from flagwrap.body.solver import make_blob_solver
+
+    blobs = np.concatenate([np.asarray(body_blobs, float), np.asarray(boundary_blobs, float)])
+    radii = np.concatenate([np.broadcast_to(body_radii, (len(body_blobs),)),
+                            np.broadcast_to(boundary_radii, (len(boundary_blobs),))])
+    u = np.zeros((len(blobs), 3))
+    u[:len(body_blobs)] = np.asarray(velocity, float)
+    lam = make_blob_solver(solver, blobs, radii, None).solve(u.ravel()).reshape(-1, 3)
+    return -lam[:len(body_blobs)].sum(axis=0)
