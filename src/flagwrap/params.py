@@ -652,6 +652,59 @@ class Wall:
 
 
 @dataclass(frozen=True)
+class TubeWall:
+    """A no-slip circular tube (``[[tube]]``, issue 32; docs/confinement.md, "Tubes"): radius
+    ``radius`` and length ``length`` [m, length unit] about the axis through ``center`` along
+    ``axis``, with an optional cosine constriction (``constriction_radius``,
+    ``constriction_length``, ``constriction_center`` along the axis from ``center``), ends
+    open or ``closed`` by discs. Discretised by blobs ``blob_spacing`` apart (default a tenth
+    of the narrowest radius) of radius ``BLOB_RADIUS_RATIO`` times the spacing
+    (:mod:`flagwrap.confinement.tube`); its beads meet it with the body's contact law."""
+
+    radius: float = 1.0
+    length: float = 1.0
+    center: tuple = (0.0, 0.0, 0.0)
+    axis: tuple = (0.0, 0.0, 1.0)
+    constriction_radius: float | None = None
+    constriction_length: float = 0.0
+    constriction_center: float = 0.0
+    closed: bool = False
+    blob_spacing: float | None = None
+
+    def __post_init__(self, where: str = "tube"):
+        for key in ("center", "axis"):
+            v = getattr(self, key)
+            if not (isinstance(v, (list, tuple)) and len(v) == 3):
+                raise UserInputError(f"{where}.{key} must be 3 numbers [x, y, z], got {v!r}")
+            _set(self, key, tuple(_finite(f"{where}.{key}", c) for c in v))
+        if not isinstance(self.closed, bool):
+            raise UserInputError(f"{where}.closed must be true or false, got {self.closed!r}")
+        if self.blob_spacing is not None:
+            bs = _finite(f"{where}.blob_spacing", self.blob_spacing)
+            if not bs > 0:
+                raise UserInputError(f"{where}.blob_spacing must be > 0, got {bs!r}")
+        self.geometry(1.0)  # radius, length, axis, constriction: checked by the geometry
+
+    def geometry(self, unit: float):
+        """The :class:`flagwrap.confinement.tube.Tube` in lengths of ``unit`` [m]."""
+        from flagwrap.confinement.tube import Tube
+
+        rc = self.constriction_radius
+        return Tube(radius=self.radius / unit, length=self.length / unit,
+                    center=tuple(c / unit for c in self.center), axis=self.axis,
+                    constriction_radius=None if rc is None else rc / unit,
+                    constriction_length=self.constriction_length / unit,
+                    constriction_center=self.constriction_center / unit, closed=self.closed)
+
+    @property
+    def resolved_blob_spacing(self) -> float:
+        if self.blob_spacing is not None:
+            return float(self.blob_spacing)
+        return 0.1 * (self.radius if self.constriction_radius is None
+                      else self.constriction_radius)
+
+
+@dataclass(frozen=True)
 class Flagellum:
     """Where one flagellum sits on the cell body (issue 28; ``[[flagellum]]`` tables, one per
     flagellum; docs/bundle.md). Every flagellum is a copy of ``[filament]`` on its own
@@ -1133,6 +1186,8 @@ class Config:
     flagella: tuple = ()
     #: no-slip plane walls (``[[wall]]``); empty: free space
     walls: tuple = ()
+    #: no-slip tubes (``[[tube]]``); empty: none
+    tubes: tuple = ()
     name: str = "run"
 
     def __post_init__(self):
@@ -1158,6 +1213,10 @@ class Config:
         for k, w in enumerate(self.walls):
             if not isinstance(w, Wall):
                 raise UserInputError(f"config.walls[{k}] must be a Wall")
+        _set(self, "tubes", tuple(self.tubes))
+        for k, t in enumerate(self.tubes):
+            if not isinstance(t, TubeWall):
+                raise UserInputError(f"config.tubes[{k}] must be a TubeWall")
         fil = self.filament
         if fil.density_mismatch is not None:
             # resolved to a density here, where the fluid's is known (as pitch-like inputs
@@ -1199,6 +1258,10 @@ class Config:
             from flagwrap.system.parts import check_walls
 
             check_walls(self)
+        if self.tubes:
+            from flagwrap.system.parts import check_tubes
+
+            check_tubes(self)
         if fil.hydrodynamic_model == "tube" and not self.numerics.hydrodynamics:
             raise UserInputError("filament.hydrodynamic_model = 'tube' needs numerics."
                                  "hydrodynamics = true (it is matched with the chain's "
@@ -1424,6 +1487,9 @@ class Config:
         walls = d.pop("walls", [])
         if walls:
             d["wall"] = walls
+        tubes = d.pop("tubes", [])
+        if tubes:
+            d["tube"] = tubes
         # pitch-like inputs are all stored after resolution; keep only pitch (canonical)
         d["filament"].pop("pitch_angle_deg", None)
         d["filament"].pop("turns", None)

@@ -246,6 +246,8 @@ FLAG = "\n[[flagellum]]\npolar_deg = 30\nazimuth_deg = 0\n"
 POLY = ("[polymorph]\nenabled = true\npolymorph_a = 'ecoli_normal'\npolymorph_b = 'ecoli_semicoiled'\n"
         "barrier = 1e-12\nstiffness = 1e-24\n")
 WALL = "\n[[wall]]\npoint = [0.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 1.0]\n"
+TUBE = ("\n[[tube]]\nradius = 0.07\nlength = 0.5\ncenter = [0.0, 0.0, -0.2]\n"
+        "blob_spacing = 0.025\n")
 
 CONFIGS = [
     ("filament", _fil("poisson_ratio = nan"), "filament.poisson_ratio"),
@@ -307,6 +309,13 @@ CONFIGS = [
     ("wall", tiny_toml() + WALL.replace("[0.0, 0.0, 1.0]", "[0.0, 1.0]"), "normal"),
     ("wall", tiny_toml() + WALL.replace("[0.0, 0.0, -0.5]", "'below'"), "point"),
     ("wall", tiny_toml() + WALL.replace("-0.5]", "1e308]"), "point"),
+    ("tube", tiny_toml() + TUBE.replace("radius = 0.07", "radius = -0.07"), "tube[0].radius"),
+    ("tube", tiny_toml() + TUBE.replace("length = 0.5", "length = nan"), "tube[0].length"),
+    ("tube", tiny_toml() + TUBE + "constriction_radius = 0.03\nconstriction_length = 0.9\n",
+     "tube[0].constriction_length"),
+    ("tube", tiny_toml() + TUBE.replace("[0.0, 0.0, -0.2]", "[0.0, 0.0]"), "tube[0].center"),
+    ("tube", tiny_toml() + TUBE + "closed = 'yes'\n", "tube[0].closed"),
+    ("tube", tiny_toml() + TUBE.replace("radius = 0.07", "radius = 0.01"), "tube[0].blob_spacing"),
     ("units", tiny_toml().replace('name = "tiny"', 'name = "tiny"\n[units]\nbending = "furlong"'), "units.bending"),
     ("polymorph", tiny_toml() + POLY.replace("'ecoli_semicoiled'", "'ecoli_square'"), "polymorph.polymorph_b"),
     ("polymorph", tiny_toml() + POLY + "rate = -1.0\n", "polymorph.rate"),
@@ -322,7 +331,7 @@ CONFIGS = [
 def test_every_config_section_has_bad_values():
     from flagwrap.io.config import _SECTIONS
 
-    assert set(_SECTIONS) | {"flagellum", "wall", "units"} <= {s for s, _, _ in CONFIGS}
+    assert set(_SECTIONS) | {"flagellum", "wall", "tube", "units"} <= {s for s, _, _ in CONFIGS}
 
 
 @pytest.mark.parametrize("section,text,needle", CONFIGS, ids=[f"{s}:{n} [{i}]" for i, (s, _, n) in enumerate(CONFIGS)])

@@ -160,14 +160,23 @@ class NoBody:
 
 
 def body_mobility(config, radius: float, wall=None):
-    """The beads' mobility beside ``config``'s fixed no-slip body
-    (:class:`~flagwrap.body.fixed_mobility.FixedBodyMobility`, bead ``radius`` in core
-    units; beside a ``wall`` too, :class:`~flagwrap.hydrodynamics.wall.PlaneWall`), or ``None``
-    for a transparent body (the free-space mobility applies)."""
-    if not config.body.no_slip:
-        return None
-    from flagwrap.body.multiblob import cell_body_blobs
+    """The beads' mobility beside ``config``'s fixed no-slip surfaces
+    (:class:`~flagwrap.body.fixed_mobility.FixedBodyMobility`, bead ``radius`` in core units):
+    the no-slip body's blobs and the ``[[tube]]``'s (:mod:`flagwrap.confinement.tube`), both
+    held still; beside a ``wall`` too (:class:`~flagwrap.hydrodynamics.wall.PlaneWall`). ``None``
+    when there is neither (the free-space mobility applies)."""
     from flagwrap.body.fixed_mobility import FixedBodyMobility
+    from flagwrap.body.multiblob import cell_body_blobs
 
-    blobs, radii = cell_body_blobs(config)
+    parts = []
+    if config.body.no_slip:
+        parts.append(cell_body_blobs(config))
+    if config.tubes and config.numerics.hydrodynamics:
+        from flagwrap.system.parts import tube_blobs
+
+        parts.append(tube_blobs(config))
+    if not parts:
+        return None
+    blobs = np.concatenate([b for b, _ in parts])
+    radii = np.concatenate([r for _, r in parts])
     return FixedBodyMobility(radius, blobs, radii, solver=config.body.solver, wall=wall)

@@ -157,7 +157,7 @@ def run(args) -> int:
     import sys
 
     from flagwrap.io.config import load_config_or_case
-    from flagwrap.stability.threshold import (critical_from_config, refuse_polymorph,
+    from flagwrap.stability.threshold import (critical_from_config, refuse_polymorph, refuse_tube,
                                               resolve_m_max)
 
     check_options(args)
@@ -165,6 +165,7 @@ def run(args) -> int:
         return _run_sweep(args)
     cfg = load_config_or_case(args.config)
     refuse_polymorph(cfg)
+    refuse_tube(cfg)
     if args.no_hi:
         cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, hydrodynamics=False))
     if _wants_far(args):

@@ -110,6 +110,39 @@ class Tube:
                 2 * np.pi * u[inside])
         return d
 
+    def wall_curvature(self, s):
+        """``d^2R/ds^2``."""
+        s = np.asarray(s, float)
+        d = np.zeros(s.shape)
+        if self.constriction_radius is not None:
+            lc = self.constriction_length
+            u = (s - self.constriction_center) / lc
+            inside = np.abs(u) < 0.5
+            d[inside] = 2.0 * (self.radius - self.constriction_radius) * (np.pi / lc) ** 2 * np.cos(
+                2 * np.pi * u[inside])
+        return d
+
+    def gap_gradient(self, x):
+        """``(gap, grad gap, r_hat, r)`` of points ``x`` (n, 3): the gradient of :meth:`gap`'s
+        formula, exact (``+inf`` gaps have zero gradient; a point on the axis takes any radial
+        direction)."""
+        x = np.asarray(x, float)
+        a = np.asarray(self.axis)
+        d = x - np.asarray(self.center)
+        s = d @ a
+        rv = d - s[:, None] * a
+        r = np.linalg.norm(rv, axis=1)
+        rhat = np.where(r[:, None] > 1e-300, rv / np.maximum(r, 1e-300)[:, None], self.frame()[0])
+        R, R1, R2 = self.wall_radius(s), self.wall_slope(s), self.wall_curvature(s)
+        c = 1.0 / np.sqrt(1.0 + R1 * R1)
+        g = (R - r) * c
+        dg_ds = R1 * c - (R - r) * R1 * R2 * c ** 3
+        grad = dg_ds[:, None] * a - c[:, None] * rhat
+        out = np.abs(s) > 0.5 * self.length
+        g = np.where(out, np.inf, g)
+        grad[out] = 0.0
+        return g, grad, rhat, r
+
     @property
     def narrowest(self) -> float:
         return self.radius if self.constriction_radius is None else self.constriction_radius

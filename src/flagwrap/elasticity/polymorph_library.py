@@ -3,7 +3,8 @@ torque-induced transitions between them, each number with its source.
 
 The data live in ``flagwrap/data/polymorphs.toml`` (docs/polymorph.md). Every number is a
 table ``{value, status, source[, note]}`` with ``status`` one of ``published``, ``derived``,
-``gap``; a gap has no value and is kept as ``None`` (never filled in). Validation raises a
+``assumption`` (a value no source prints for this organism, chosen for a stated reason: the
+note must say it), ``gap``; a gap has no value and is kept as ``None`` (never filled in). Validation raises a
 one-line :class:`UserInputError` naming the key and the allowed range: an unknown polymorph
 name, a polymorph without ``radius_um`` or ``pitch_um`` (a value or an explicit gap), a
 transition torque of the wrong sign, a domain-wall width below the bead spacing.
@@ -34,7 +35,7 @@ __all__ = ["STATUSES", "Sourced", "Polymorph", "Transition", "PolymorphLibrary",
            "parse_library", "default_library", "load_library_file"]
 
 #: allowed provenance statuses
-STATUSES = ("published", "derived", "gap")
+STATUSES = ("published", "derived", "assumption", "gap")
 #: most a length in um or a torque in pN um may be (a physical value, not a typo)
 _MAX = 1e6
 
@@ -140,6 +141,8 @@ def _sourced(where: str, name: str, entry: Any, kind: str = "number",
         return Sourced(None, status, source, note)
     if "value" not in entry:
         raise UserInputError(f"{label} needs a 'value' (or status = \"gap\")")
+    if status == "assumption" and not note.strip():
+        raise UserInputError(f"{label} has status 'assumption': its 'note' must say why this value")
     v = entry["value"]
     if kind == "handedness":
         if v not in ("left", "right"):

@@ -70,3 +70,51 @@ class WallContact:
         rows = np.broadcast_to(base + np.arange(3)[None, :, None], H.shape)
         cols = np.broadcast_to(base + np.arange(3)[None, None, :], H.shape)
         return rows.ravel(), cols.ravel(), H.ravel()
+
+
+class TubeContact(WallContact):
+    """The interaction of beads ``active`` with a tube's wall (``[[tube]]``,
+    :class:`flagwrap.confinement.tube.Tube` in core units): the same law on each bead's gap
+    ``g`` to the wall (:meth:`~flagwrap.confinement.tube.Tube.gap`); the gradient
+    ``u'(g) grad g``, exact; the Hessian ``u'' grad g grad g^T + u' H_g`` with the straight
+    tube's ``H_g = -(I - a a^T - r r^T) / r`` (the constriction's further terms are left to the
+    W-method, which keeps its order for any W)."""
+
+    name = "tube contact"
+
+    def __init__(self, tube, cutoff: float, strength: float, active, c2: float = 1.0):
+        self.tube = tube
+        self.rotation_invariant = False
+        self.cutoff = float(cutoff)
+        self.sigma = self.cutoff / 2.0 ** (1.0 / 6.0)
+        self.strength = float(strength)
+        self.c2 = float(c2)
+        self.active = np.asarray(active, bool)
+        self.distance = None
+        self.energy = 0.0
+
+    def energy_grad(self, x, theta, grad_x, grad_theta) -> float:
+        on = self.active
+        g, dg, _, _ = self.tube.gap_gradient(x[on])
+        self.distance = self.tube.gap(x)
+        e, dU, _ = self.law(g)
+        grad_x[on] += dU[:, None] * dg
+        self.energy = float(e.sum())
+        return self.energy
+
+    def hessian_coo(self, x, theta):
+        ids = np.flatnonzero(self.active)
+        g, dg, rhat, r = self.tube.gap_gradient(x[ids])
+        _, dU, d2U = self.law(g)
+        near = np.flatnonzero(d2U != 0.0)
+        if near.size == 0:
+            return None
+        a = np.asarray(self.tube.axis)
+        P = np.eye(3)[None] - a[None, :, None] * a[None, None, :] - \
+            rhat[near, :, None] * rhat[near, None, :]
+        H = d2U[near, None, None] * dg[near, :, None] * dg[near, None, :] - \
+            (dU[near] / np.maximum(r[near], 1e-300))[:, None, None] * P
+        base = 3 * ids[near][:, None, None]
+        rows = np.broadcast_to(base + np.arange(3)[None, :, None], H.shape)
+        cols = np.broadcast_to(base + np.arange(3)[None, None, :], H.shape)
+        return rows.ravel(), cols.ravel(), H.ravel()

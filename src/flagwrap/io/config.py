@@ -24,8 +24,8 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from flagwrap.errors import UserInputError
-from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Flagellum, Fluid, Wall,
-                             Initial, Joint, Motor, Numerics, Phase, Polymorph)
+from flagwrap.params import (CellBody, Clamp, Config, Contact, Filament, Flagellum, Fluid,
+                             Initial, Joint, Motor, Numerics, Phase, Polymorph, TubeWall, Wall)
 
 _SECTIONS = {
     "filament": Filament,
@@ -105,7 +105,7 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
     if not isinstance(data, dict):
         raise UserInputError("config must be a TOML table")
     data = dict(data)
-    allowed_top = set(_SECTIONS) | {"units", "name", "flagellum", "wall"}
+    allowed_top = set(_SECTIONS) | {"units", "name", "flagellum", "wall", "tube"}
     for key in data:
         if key not in allowed_top:
             raise UserInputError(f"unknown section or key {key!r}; allowed: {', '.join(sorted(allowed_top))}")
@@ -160,6 +160,8 @@ def config_from_dict(data: dict, name: str | None = None) -> Config:
         kwargs["flagella"] = _flagella(data["flagellum"], lf, tf)
     if "wall" in data:
         kwargs["walls"] = _walls(data["wall"], lf)
+    if "tube" in data:
+        kwargs["tubes"] = _tubes(data["tube"], lf)
     nm = data.get("name", name or "run")
     if not isinstance(nm, str) or not nm:
         raise UserInputError("name must be a non-empty string")
@@ -237,6 +239,39 @@ def _walls(tables, lf: float) -> tuple:
             out.append(Wall(**t))
         except UserInputError as exc:
             raise UserInputError(str(exc).replace("wall", where, 1)) from None
+    return tuple(out)
+
+
+#: [[tube]] keys that are lengths (in the [units] length unit)
+_TUBE_LENGTHS = ("radius", "length", "constriction_radius", "constriction_length",
+                 "constriction_center", "blob_spacing")
+
+
+def _tubes(tables, lf: float) -> tuple:
+    """``[[tube]]`` tables -> :class:`~flagwrap.params.TubeWall` s (lengths and ``center`` in
+    the length unit ``lf``); a problem names the table, ``tube[k].key``."""
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        raise UserInputError("tube must be an array of tables: [[tube]] per tube")
+    known = _fields(TubeWall)
+    out = []
+    for k, t in enumerate(tables):
+        where = f"tube[{k}]"
+        for key in t:
+            if key not in known:
+                raise UserInputError(f"unknown key {where}.{_show(key)}; allowed: "
+                                     f"{', '.join(sorted(known))}")
+        t = dict(t)
+        for key in _TUBE_LENGTHS:
+            if _is_number(t.get(key)):
+                t[key] = t[key] * lf
+        if isinstance(t.get("center"), list) and all(_is_number(c) for c in t["center"]):
+            t["center"] = [c * lf for c in t["center"]]
+        try:
+            out.append(TubeWall(**t))
+        except UserInputError as exc:
+            raise UserInputError(str(exc).replace("tube", where, 1)) from None
+        except TypeError as exc:
+            raise UserInputError(f"{where}: {exc}") from None
     return tuple(out)
 
 
@@ -319,6 +354,14 @@ def config_to_toml(cfg: Config, for_hash: bool = False) -> str:
         lines.append("[[wall]]")
         for k, v in table.items():
             lines.append(f"{k} = [{', '.join(_toml_value(c) for c in v)}]")
+        lines.append("")
+    for table in d.get("tube", []):
+        lines.append("[[tube]]")
+        for k, v in table.items():
+            if isinstance(v, (list, tuple)):
+                lines.append(f"{k} = [{', '.join(_toml_value(c) for c in v)}]")
+            else:
+                lines.append(f"{k} = {_toml_value(v)}")
         lines.append("")
     for table in d.get("flagellum", []):
         lines.append("[[flagellum]]")

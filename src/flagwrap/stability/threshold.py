@@ -259,6 +259,16 @@ def refuse_polymorph(config) -> None:
             "polymorph_a")
 
 
+def refuse_tube(config) -> None:
+    """A one-line :class:`UserInputError` for a ``[[tube]]``: its blobs are not symmetric
+    about the motor axis, so there is no steady whirl of the turning frame to linearise."""
+    if config.tubes:
+        raise UserInputError(
+            "[[tube]] is not available to flagwrap stability (a tube of blobs breaks the "
+            "turning frame's symmetry about the motor axis); run it in the time domain "
+            "(flagwrap run)")
+
+
 def make_frame(config, omega: float):
     """The turning frame of ``config``'s system at ``omega``: a free swimmer's
     (:class:`~flagwrap.system.swimmer.SwimmerFrame`) or the rig's
@@ -266,6 +276,7 @@ def make_frame(config, omega: float):
     at one angle, ``blob_body``). A polymorphic filament is refused by name: its order
     parameters are not unknowns of the turning frame yet (docs/polymorph.md)."""
     refuse_polymorph(config)
+    refuse_tube(config)
     if config.body.free:
         if config.walls:
             raise UserInputError(

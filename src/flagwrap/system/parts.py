@@ -455,6 +455,78 @@ def check_walls(config) -> None:
                                  f"wall ({-h:.3g} m behind it): move the wall or turn its normal")
 
 
+def config_tube(config):
+    """The config's ``[[tube]]`` (one; :func:`check_tubes`) as a
+    :class:`flagwrap.confinement.tube.Tube` in core units (lengths in ``L``), or None."""
+    if not config.tubes:
+        return None
+    return config.tubes[0].geometry(config.filament.length)
+
+
+def tube_blobs(config) -> tuple[np.ndarray, np.ndarray]:
+    """The blobs (n, 3) and radii (n,) of the config's tube in core units."""
+    from flagwrap.confinement.tube import BLOB_RADIUS_RATIO
+
+    L = config.filament.length
+    h = config.tubes[0].resolved_blob_spacing / L
+    blobs = config_tube(config).blob_shell(h, BLOB_RADIUS_RATIO * h)
+    return blobs, np.full(len(blobs), BLOB_RADIUS_RATIO * h)
+
+
+def check_tubes(config) -> None:
+    """Refuse ``[[tube]]`` tables that cannot be run (one line naming the key, before any
+    work): more than one tube, a tube with a wall, a free body in a tube (not built: its
+    blobs move through the tube's), the turning frame (a blob tube is not symmetric about the
+    motor axis), blobs too sparse for the tube, a body as wide as the tube (a constriction
+    narrower than the body is allowed: whether the cell passes is the question), a filament or
+    body that starts across the tube's wall."""
+    from flagwrap.errors import UserInputError
+    from flagwrap.geometry.helix import filament_positions
+
+    if len(config.tubes) > 1:
+        raise UserInputError(f"{len(config.tubes)} [[tube]] tables: one tube is supported")
+    if config.walls:
+        raise UserInputError("[[tube]] with [[wall]]: one boundary at a time is supported; "
+                             "drop one")
+    if config.body.free:
+        raise UserInputError("[[tube]] around a free body (body.motion = 'free') is not built "
+                             "yet: hold the body (body.motion = 'fixed') or drop the tube")
+    if config.numerics.frame != "lab":
+        raise UserInputError(f"[[tube]] with numerics.frame = {config.numerics.frame!r}: a "
+                             "tube of blobs is not symmetric about the motor axis; use "
+                             "numerics.frame = 'lab'")
+    t, L = config.tubes[0], config.filament.length
+    tube = config_tube(config)
+    if t.resolved_blob_spacing >= tube.narrowest * L:
+        raise UserInputError(f"tube[0].blob_spacing = {t.resolved_blob_spacing:g} m must be "
+                             f"below the tube's narrowest radius {tube.narrowest * L:g} m")
+    fil = config.filament
+    a = fil.cross_section_radius
+    shape = filament_positions(fil, config.clamp) / L
+    for k, pl in enumerate(placements_from_config(config) or [Placement()]):
+        gap = tube.gap(pl.apply(shape))
+        g = float(np.min(gap)) * L
+        if not g > a:
+            where = f"flagellum[{k}]" if config.flagella else "the filament"
+            raise UserInputError(
+                f"tube[0]: {where} starts {g:.3g} m from the tube's wall (inside), less than "
+                f"its radius a = {a:.3g} m, or outside the tube: move the tube (tube.center) "
+                "or widen it (tube.radius)")
+    if config.body.enabled:
+        from flagwrap.body.multiblob import cell_body_blobs
+
+        rb = config.body.resolved_radius(fil.helix_radius)
+        if rb >= tube.radius * L:  # a constriction narrower than the body is a question
+            raise UserInputError(f"tube[0].radius = {tube.radius * L:g} m: the cell body "
+                                 f"(radius {rb:g} m) is as wide or wider; widen the tube")
+        blobs, _ = cell_body_blobs(config)
+        g = float(np.min(tube.gap(blobs))) * L
+        if not g > 0.0:
+            raise UserInputError(f"tube[0]: the cell body crosses the tube's wall or lies "
+                                 "outside the tube: move the tube (tube.center) or widen it "
+                                 "(tube.radius)")
+
+
 def _min_segment_distance(x, z) -> float:
     """The smallest distance between a segment of chain ``x`` and one of chain ``z``."""
     from flagwrap.interactions.self_contact import segment_closest

@@ -38,7 +38,7 @@ from flagwrap.hydrodynamics.wall import WallMobility, config_wall
 from flagwrap.motor.drive import make_drive
 from flagwrap.motor.protocol import motor_schedule
 from flagwrap.system.layout import DofLayout
-from flagwrap.system.parts import build_parts
+from flagwrap.system.parts import build_parts, config_tube
 
 
 @dataclass
@@ -156,6 +156,9 @@ class RodSystem:
         num = config.numerics
         #: the no-slip plane (``[[wall]]``) in core units, or None
         self.wall = config_wall(config)
+        #: the no-slip tube (``[[tube]]``, :class:`flagwrap.confinement.tube.Tube`) in core
+        #: units, or None
+        self.tube = config_tube(config)
         if mobility is None:
             mobility = body_mobility(config, self.radius, self.wall)
         if mobility is None:
@@ -267,6 +270,14 @@ class RodSystem:
                 active[p.bead0:p.bead0 + p.nc] = False
             cutoff, strength, c2 = contact_law(self.config, self.bond)
             out.append(WallContact(self.wall, cutoff, strength, active, c2=c2))
+        if self.tube is not None:
+            from flagwrap.interactions.wall import TubeContact, contact_law
+
+            active = np.ones(self.N, bool)
+            for p in self.parts:
+                active[p.bead0:p.bead0 + p.nc] = False
+            cutoff, strength, c2 = contact_law(self.config, self.bond)
+            out.append(TubeContact(self.tube, cutoff, strength, active, c2=c2))
         if not c.self_contact:
             return out
         from flagwrap.interactions.self_contact import SelfContact, SelfContactInteraction

@@ -1,0 +1,163 @@
+"""A tube as a part of the system (``[[tube]]``; docs/confinement.md, "Tubes"): every kind of
+system that takes one runs inside it and stores it, its blobs screen the beads' flow, its
+contact is its energy's gradient, and every kind that does not take one is refused by name."""
+
+import tomllib
+
+import numpy as np
+import pytest
+
+from conftest import tiny_toml
+from flagwrap.errors import UserInputError
+from flagwrap.io.config import config_from_dict, config_to_toml
+
+# the tiny rig hangs from the origin to z ~ -0.38 m, helix radius 0.03 m
+TUBE = ("[[tube]]\nradius = 0.07\nlength = 0.5\ncenter = [0.0, 0.0, -0.2]\n"
+        "blob_spacing = 0.025\n")
+BODY = "[body]\nsurface = 'no-slip'\nblob_spacing = 0.025\n"
+KINDS = {
+    "lab": ("", ""),
+    "krylov": ("linear_solver = 'krylov'\n", ""),
+    "no hydrodynamics (contact only)": ("hydrodynamics = false\n", ""),
+    "tube chain": ("", "", "hydrodynamic_model = 'tube'\n"),
+    "fixed no-slip body": ("", BODY),
+}
+
+
+def _text(numerics="", tables="", fil=None, tube=TUBE, **kw):
+    text = tiny_toml(**kw).replace("[numerics]\n", "[numerics]\n" + numerics)
+    if fil:
+        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil)
+    return text + tables + tube
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_every_kind_of_system_runs_in_a_tube(kind, tmp_path):
+    from flagwrap.body.fixed_mobility import FixedBodyMobility
+    from flagwrap.hydrodynamics.tube import TubeMobility
+    from flagwrap.interactions.wall import TubeContact
+    from flagwrap.io.runfile import config_of, read_run, write_run
+    from flagwrap.simulation import make_system, simulate
+
+    cfg = config_from_dict(tomllib.loads(_text(*KINDS[kind][:2], *KINDS[kind][2:],
+                                               ccw=0.2, cw=0.1)))
+    s = make_system(cfg)
+    assert any(isinstance(it, TubeContact) for it in s.interactions)
+    m = s.mobility.inner if isinstance(s.mobility, TubeMobility) else s.mobility
+    if cfg.numerics.hydrodynamics:
+        assert isinstance(m, FixedBodyMobility)
+        n_body = 0
+        if cfg.body.no_slip:
+            from flagwrap.body.multiblob import cell_body_blobs
+
+            n_body = len(cell_body_blobs(cfg)[0])
+        from flagwrap.system.parts import tube_blobs
+
+        assert len(m.blobs) == n_body + len(tube_blobs(cfg)[0])
+    tr = simulate(cfg)
+    assert tr.ok and tr.n_steps > 0
+    write_run(tr, tmp_path / "run.nc")
+    assert config_of(read_run(tmp_path / "run.nc")).tubes == cfg.tubes  # stored
+
+
+def test_tube_screens_the_beads_flow():
+    """The tube's blobs take flow off the beads: the mobility inside the tube is symmetric
+    positive definite and below free space's (M_free - M_tube = the screening, SPD)."""
+    from flagwrap.simulation import make_system
+
+    cfg = config_from_dict(tomllib.loads(_text()))
+    s = make_system(cfg)
+    x = s.positions(s.initial_state()) if hasattr(s, "positions") else None
+    x = np.asarray(s.x0 if x is None else x)
+    M = s.mobility.matrix(x)
+    free = config_from_dict(tomllib.loads(_text(tube="")))
+    M0 = make_system(free).mobility.matrix(x)
+    assert np.allclose(M, M.T, atol=1e-12 * np.abs(M).max())
+    assert np.linalg.eigvalsh(M).min() > 0
+    assert np.linalg.eigvalsh(M0 - M).min() > -1e-10 * np.abs(M).max()
+    assert np.linalg.norm(M0 - M) > 1e-3 * np.linalg.norm(M0)
+
+
+def test_tube_contact_is_its_energy_gradient_and_hessian():
+    from flagwrap.confinement.tube import Tube
+    from flagwrap.interactions.wall import TubeContact
+
+    t = Tube(1.0, 6.0, constriction_radius=0.7, constriction_length=2.0, axis=(0.1, 0.0, 1.0))
+    rng = np.random.default_rng(3)
+    ang = rng.uniform(0, 2 * np.pi, 30)
+    s = rng.uniform(-2.5, 2.5, 30)
+    e1, e2, a = t.frame()
+    r = t.wall_radius(s) - rng.uniform(0.03, 0.05, 30)  # near the wall, inside the cutoff
+    x = s[:, None] * a + r[:, None] * (np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2)
+    c = TubeContact(t, 0.06, 1.0, np.ones(30, bool))
+    g = np.zeros_like(x)
+    c.energy_grad(x, None, g, None)
+    num = np.zeros_like(x)
+    eps = 1e-8
+    scratch = np.zeros_like(x)
+    for i in range(30):
+        for k in range(3):
+            xp, xm = x.copy(), x.copy()
+            xp[i, k] += eps
+            xm[i, k] -= eps
+            num[i, k] = (c.energy_grad(xp, None, scratch, None)
+                         - c.energy_grad(xm, None, scratch, None)) / (2 * eps)
+    assert np.allclose(g, num, rtol=1e-5, atol=1e-7 * np.abs(g).max())
+    # the Hessian of a straight tube is exact
+    st = Tube(1.0, 6.0)
+    xs = s[:, None] * st.frame()[2] + (0.98 * (np.cos(ang)[:, None] * st.frame()[0]
+                                               + np.sin(ang)[:, None] * st.frame()[1]))
+    cs = TubeContact(st, 0.06, 1.0, np.ones(30, bool))
+    rows, cols, vals = cs.hessian_coo(xs, None)
+    H = np.zeros((90, 90))
+    np.add.at(H, (rows, cols), vals)
+    Hn = np.zeros((90, 90))
+    for j in range(90):
+        d = np.zeros(90)
+        d[j] = 1e-7
+        gp, gm = np.zeros((30, 3)), np.zeros((30, 3))
+        cs.energy_grad(xs + d.reshape(30, 3), None, gp, None)
+        cs.energy_grad(xs - d.reshape(30, 3), None, gm, None)
+        Hn[:, j] = (gp - gm).ravel() / 2e-7
+    assert np.allclose(H, Hn, rtol=1e-4, atol=1e-5 * np.abs(H).max())
+
+
+def test_config_round_trips():
+    cfg = config_from_dict(tomllib.loads(_text(tube=TUBE + "constriction_radius = 0.05\n"
+                                               "constriction_length = 0.1\nclosed = true\n")))
+    back = config_from_dict(tomllib.loads(config_to_toml(cfg)))
+    assert back.tubes == cfg.tubes and back.tubes[0].closed
+    assert back.tubes[0].constriction_radius == pytest.approx(0.05)
+
+
+@pytest.mark.parametrize("numerics, tables, tube, key", [
+    ("frame = 'rotating'\n", "", TUBE, "numerics.frame"),
+    ("", BODY + "motion = 'free'\n", TUBE, "body.motion"),
+    ("", "", TUBE + TUBE, "one tube"),
+    ("", "[[wall]]\npoint = [0.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 1.0]\n", TUBE, r"\[\[wall\]\]"),
+    ("", "", TUBE.replace("radius = 0.07", "radius = 0.04"), "the filament starts"),
+    ("", "", TUBE.replace("radius = 0.07", "radius = 0.02"), r"tube\[0\]\.blob_spacing"),
+    ("", "", TUBE.replace("center = [0.0, 0.0, -0.2]", "center = [0.2, 0.0, -0.2]"),
+     "the filament starts"),
+    ("", BODY + "radius = 0.08\n", TUBE, r"tube\[0\]\.radius"),
+    ("", "", TUBE + "constriction_radius = 0.05\nconstriction_length = 0.6\n",
+     r"tube\[0\]\.constriction_length"),
+    ("", "", TUBE + "constriction_radius = 0.08\nconstriction_length = 0.1\n",
+     r"tube\[0\]\.constriction_radius"),
+    ("", "", TUBE.replace("center = [0.0, 0.0, -0.2]", "axis = [0.0, 0.0, 0.0]"),
+     r"tube\[0\]\.axis"),
+    ("", "", TUBE + "colour = 'red'\n", r"unknown key tube\[0\]\.colour"),
+    ("", "", TUBE.replace("blob_spacing = 0.025", "blob_spacing = -1.0"),
+     r"tube\[0\]\.blob_spacing"),
+])
+def test_refusals_name_the_key(numerics, tables, tube, key):
+    with pytest.raises(UserInputError, match=key):
+        config_from_dict(tomllib.loads(_text(numerics, tables, tube=tube)))
+
+
+def test_stability_refuses_a_tube_by_name():
+    from flagwrap.stability.threshold import make_frame
+
+    cfg = config_from_dict(tomllib.loads(_text()))
+    with pytest.raises(UserInputError, match=r"\[\[tube\]\] is not available to flagwrap stability"):
+        make_frame(cfg, 1.0)
