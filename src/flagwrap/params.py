@@ -625,6 +625,15 @@ class Joint:
         return self == Joint()
 
 
+def _set_vectors(obj, where: str, keys) -> None:
+    """Each of ``obj``'s fields ``keys`` checked as 3 finite numbers and stored as a tuple."""
+    for key in keys:
+        v = getattr(obj, key)
+        if not (isinstance(v, (list, tuple)) and len(v) == 3):
+            raise UserInputError(f"{where}.{key} must be 3 numbers [x, y, z], got {v!r}")
+        _set(obj, key, tuple(_finite(f"{where}.{key}", c) for c in v))
+
+
 @dataclass(frozen=True)
 class Wall:
     """A no-slip plane wall (``[[wall]]``, issue 32; docs/confinement.md): the plane through
@@ -637,11 +646,7 @@ class Wall:
     normal: tuple = (0.0, 0.0, 1.0)
 
     def __post_init__(self, where: str = "wall"):
-        for key in ("point", "normal"):
-            v = getattr(self, key)
-            if not (isinstance(v, (list, tuple)) and len(v) == 3):
-                raise UserInputError(f"{where}.{key} must be 3 numbers [x, y, z], got {v!r}")
-            _set(self, key, tuple(_finite(f"{where}.{key}", c) for c in v))
+        _set_vectors(self, where, ("point", "normal"))
         if not math.hypot(*self.normal) > 0.0:
             raise UserInputError(f"{where}.normal must not be zero (it points into the fluid)")
 
@@ -672,11 +677,7 @@ class TubeWall:
     blob_spacing: float | None = None
 
     def __post_init__(self, where: str = "tube"):
-        for key in ("center", "axis"):
-            v = getattr(self, key)
-            if not (isinstance(v, (list, tuple)) and len(v) == 3):
-                raise UserInputError(f"{where}.{key} must be 3 numbers [x, y, z], got {v!r}")
-            _set(self, key, tuple(_finite(f"{where}.{key}", c) for c in v))
+        _set_vectors(self, where, ("center", "axis"))
         if not isinstance(self.closed, bool):
             raise UserInputError(f"{where}.closed must be true or false, got {self.closed!r}")
         if self.blob_spacing is not None:

@@ -87,40 +87,28 @@ class Tube:
                     f"|center| + length/2 <= {self.length / 2:g}, got {sc!r} (length {lc:g})")
 
     # --- the surface --------------------------------------------------------------------
-    def wall_radius(self, s):
-        """``R(s)`` (module docstring)."""
+    def profile(self, s):
+        """``(R, dR/ds, d^2R/ds^2)`` at ``s`` (module docstring), in one pass."""
         s = np.asarray(s, float)
         R = np.full(s.shape, float(self.radius))
+        R1, R2 = np.zeros(s.shape), np.zeros(s.shape)
         if self.constriction_radius is not None:
-            u = (s - self.constriction_center) / self.constriction_length
+            lc, depth = self.constriction_length, self.radius - self.constriction_radius
+            u = (s - self.constriction_center) / lc
             inside = np.abs(u) < 0.5
-            R[inside] -= (self.radius - self.constriction_radius) * 0.5 * (
-                1 + np.cos(2 * np.pi * u[inside]))
-        return R
+            ph = 2 * np.pi * u[inside]
+            R[inside] -= depth * 0.5 * (1 + np.cos(ph))
+            R1[inside] = depth * np.pi / lc * np.sin(ph)
+            R2[inside] = 2.0 * depth * (np.pi / lc) ** 2 * np.cos(ph)
+        return R, R1, R2
+
+    def wall_radius(self, s):
+        """``R(s)`` (module docstring)."""
+        return self.profile(s)[0]
 
     def wall_slope(self, s):
         """``dR/ds``."""
-        s = np.asarray(s, float)
-        d = np.zeros(s.shape)
-        if self.constriction_radius is not None:
-            lc = self.constriction_length
-            u = (s - self.constriction_center) / lc
-            inside = np.abs(u) < 0.5
-            d[inside] = (self.radius - self.constriction_radius) * np.pi / lc * np.sin(
-                2 * np.pi * u[inside])
-        return d
-
-    def wall_curvature(self, s):
-        """``d^2R/ds^2``."""
-        s = np.asarray(s, float)
-        d = np.zeros(s.shape)
-        if self.constriction_radius is not None:
-            lc = self.constriction_length
-            u = (s - self.constriction_center) / lc
-            inside = np.abs(u) < 0.5
-            d[inside] = 2.0 * (self.radius - self.constriction_radius) * (np.pi / lc) ** 2 * np.cos(
-                2 * np.pi * u[inside])
-        return d
+        return self.profile(s)[1]
 
     def gap_gradient(self, x):
         """``(gap, grad gap, r_hat, r)`` of points ``x`` (n, 3): the gradient of :meth:`gap`'s
@@ -133,7 +121,7 @@ class Tube:
         rv = d - s[:, None] * a
         r = np.linalg.norm(rv, axis=1)
         rhat = np.where(r[:, None] > 1e-300, rv / np.maximum(r, 1e-300)[:, None], self.frame()[0])
-        R, R1, R2 = self.wall_radius(s), self.wall_slope(s), self.wall_curvature(s)
+        R, R1, R2 = self.profile(s)
         c = 1.0 / np.sqrt(1.0 + R1 * R1)
         g = (R - r) * c
         dg_ds = R1 * c - (R - r) * R1 * R2 * c ** 3
@@ -167,7 +155,8 @@ class Tube:
         docstring): positive inside the tube, negative across its wall. Past the open ends a
         point is outside the tube (``+inf``: nothing to meet)."""
         s, r = self.cylindrical(x)
-        g = (self.wall_radius(s) - r) / np.sqrt(1.0 + self.wall_slope(s) ** 2)
+        R, R1, _ = self.profile(s)
+        g = (R - r) / np.sqrt(1.0 + R1 ** 2)
         return np.where(np.abs(s) <= 0.5 * self.length, g, np.inf)
 
     # --- blobs ---------------------------------------------------------------------------
@@ -187,7 +176,8 @@ class Tube:
         # the meridian r = R(s) + off, sampled finely, cut at equal arc length
         half = 0.5 * self.length
         ss = np.linspace(-half, half, max(2001, int(40 * self.length / spacing)))
-        rr = self.wall_radius(ss) + off * np.sqrt(1.0 + self.wall_slope(ss) ** 2)
+        R, R1, _ = self.profile(ss)
+        rr = R + off * np.sqrt(1.0 + R1 ** 2)
         arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(ss), np.diff(rr)))])
         n_rings = max(2, int(round(arc[-1] / spacing)) + 1)
         at = np.linspace(0.0, arc[-1], n_rings)

@@ -24,23 +24,20 @@ def contact_law(config, bond: float) -> tuple[float, float, float]:
             1.0 if c.potential == "wca-c2" else 0.0)
 
 
-class WallContact:
-    """The interaction (:mod:`flagwrap.interactions.base`) of beads ``active`` with the plane
-    ``wall`` (:class:`flagwrap.hydrodynamics.wall.PlaneWall`, core units)."""
+class _BoundaryContact:
+    """The contact law's part shared by a plane and a tube: beads ``active`` meet a fixed
+    boundary by ``u(d)`` on their distance ``d`` to it."""
 
-    name = "wall contact"
     nonlocal_hessian = False
+    rotation_invariant = False
 
-    def __init__(self, wall, cutoff: float, strength: float, active, c2: float = 1.0):
-        self.wall = wall
-        #: a plane square to the body axis is unchanged by turning about it
-        self.rotation_invariant = wall.square_to_z
+    def __init__(self, cutoff: float, strength: float, active, c2: float = 1.0):
         self.cutoff = float(cutoff)
         self.sigma = self.cutoff / 2.0 ** (1.0 / 6.0)
         self.strength = float(strength)
         self.c2 = float(c2)
         self.active = np.asarray(active, bool)
-        self.distance = None  # the last evaluation's heights
+        self.distance = None  # the last evaluation's distances
         self.energy = 0.0
 
     def law(self, d):
@@ -48,6 +45,19 @@ class WallContact:
         e, dU, d2U = np.empty(len(d)), np.empty(len(d)), np.empty(len(d))
         BK.wca_law(d, self.sigma, self.strength, self.c2, e, dU, d2U)
         return e, dU, d2U
+
+
+class WallContact(_BoundaryContact):
+    """The interaction (:mod:`flagwrap.interactions.base`) of beads ``active`` with the plane
+    ``wall`` (:class:`flagwrap.hydrodynamics.wall.PlaneWall`, core units)."""
+
+    name = "wall contact"
+
+    def __init__(self, wall, cutoff: float, strength: float, active, c2: float = 1.0):
+        super().__init__(cutoff, strength, active, c2)
+        self.wall = wall
+        #: a plane square to the body axis is unchanged by turning about it
+        self.rotation_invariant = wall.square_to_z
 
     def energy_grad(self, x, theta, grad_x, grad_theta) -> float:
         d = self.wall.heights(x)
@@ -72,7 +82,7 @@ class WallContact:
         return rows.ravel(), cols.ravel(), H.ravel()
 
 
-class TubeContact(WallContact):
+class TubeContact(_BoundaryContact):
     """The interaction of beads ``active`` with a tube's wall (``[[tube]]``,
     :class:`flagwrap.confinement.tube.Tube` in core units): the same law on each bead's gap
     ``g`` to the wall (:meth:`~flagwrap.confinement.tube.Tube.gap`); the gradient
@@ -83,22 +93,15 @@ class TubeContact(WallContact):
     name = "tube contact"
 
     def __init__(self, tube, cutoff: float, strength: float, active, c2: float = 1.0):
+        super().__init__(cutoff, strength, active, c2)
         self.tube = tube
-        self.rotation_invariant = False
-        self.cutoff = float(cutoff)
-        self.sigma = self.cutoff / 2.0 ** (1.0 / 6.0)
-        self.strength = float(strength)
-        self.c2 = float(c2)
-        self.active = np.asarray(active, bool)
-        self.distance = None
-        self.energy = 0.0
 
     def energy_grad(self, x, theta, grad_x, grad_theta) -> float:
+        g, dg, _, _ = self.tube.gap_gradient(x)
+        self.distance = g
         on = self.active
-        g, dg, _, _ = self.tube.gap_gradient(x[on])
-        self.distance = self.tube.gap(x)
-        e, dU, _ = self.law(g)
-        grad_x[on] += dU[:, None] * dg
+        e, dU, _ = self.law(g[on])
+        grad_x[on] += dU[:, None] * dg[on]
         self.energy = float(e.sum())
         return self.energy
 

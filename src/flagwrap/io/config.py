@@ -219,27 +219,37 @@ def _flagella(tables, lf: float, tf: float = 1.0) -> tuple:
     return tuple(out)
 
 
-def _walls(tables, lf: float) -> tuple:
-    """``[[wall]]`` tables -> :class:`~flagwrap.params.Wall` s (``point`` in the length unit
-    ``lf``); a problem names the table, ``wall[k].key``."""
+def _boundary_tables(tables, cls, name: str, scale) -> tuple:
+    """``[[name]]`` tables -> ``cls`` instances: unknown keys refused, ``scale(t)`` converts a
+    table's lengths in place, a problem names the table, ``name[k].key``."""
     if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
-        raise UserInputError("wall must be an array of tables: [[wall]] per wall")
-    known = _fields(Wall)
+        raise UserInputError(f"{name} must be an array of tables: [[{name}]] per {name}")
+    known = _fields(cls)
     out = []
     for k, t in enumerate(tables):
-        where = f"wall[{k}]"
+        where = f"{name}[{k}]"
         for key in t:
             if key not in known:
                 raise UserInputError(f"unknown key {where}.{_show(key)}; allowed: "
                                      f"{', '.join(sorted(known))}")
         t = dict(t)
-        if isinstance(t.get("point"), list) and all(_is_number(c) for c in t["point"]):
-            t["point"] = [c * lf for c in t["point"]]
+        scale(t)
         try:
-            out.append(Wall(**t))
+            out.append(cls(**t))
         except UserInputError as exc:
-            raise UserInputError(str(exc).replace("wall", where, 1)) from None
+            raise UserInputError(str(exc).replace(name, where, 1)) from None
     return tuple(out)
+
+
+def _scale_vector(t: dict, key: str, lf: float) -> None:
+    if isinstance(t.get(key), list) and all(_is_number(c) for c in t[key]):
+        t[key] = [c * lf for c in t[key]]
+
+
+def _walls(tables, lf: float) -> tuple:
+    """``[[wall]]`` tables -> :class:`~flagwrap.params.Wall` s (``point`` in the length unit
+    ``lf``)."""
+    return _boundary_tables(tables, Wall, "wall", lambda t: _scale_vector(t, "point", lf))
 
 
 #: [[tube]] keys that are lengths (in the [units] length unit)
@@ -249,30 +259,14 @@ _TUBE_LENGTHS = ("radius", "length", "constriction_radius", "constriction_length
 
 def _tubes(tables, lf: float) -> tuple:
     """``[[tube]]`` tables -> :class:`~flagwrap.params.TubeWall` s (lengths and ``center`` in
-    the length unit ``lf``); a problem names the table, ``tube[k].key``."""
-    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
-        raise UserInputError("tube must be an array of tables: [[tube]] per tube")
-    known = _fields(TubeWall)
-    out = []
-    for k, t in enumerate(tables):
-        where = f"tube[{k}]"
-        for key in t:
-            if key not in known:
-                raise UserInputError(f"unknown key {where}.{_show(key)}; allowed: "
-                                     f"{', '.join(sorted(known))}")
-        t = dict(t)
+    the length unit ``lf``)."""
+    def scale(t):
         for key in _TUBE_LENGTHS:
             if _is_number(t.get(key)):
                 t[key] = t[key] * lf
-        if isinstance(t.get("center"), list) and all(_is_number(c) for c in t["center"]):
-            t["center"] = [c * lf for c in t["center"]]
-        try:
-            out.append(TubeWall(**t))
-        except UserInputError as exc:
-            raise UserInputError(str(exc).replace("tube", where, 1)) from None
-        except TypeError as exc:
-            raise UserInputError(f"{where}: {exc}") from None
-    return tuple(out)
+        _scale_vector(t, "center", lf)
+
+    return _boundary_tables(tables, TubeWall, "tube", scale)
 
 
 def load_config_or_case(name) -> Config:

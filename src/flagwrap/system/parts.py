@@ -405,6 +405,18 @@ def check_connector(config) -> None:
                 f"{-d:.3g} m; turn the motor axis along the surface normal or use lead = 'kink'")
 
 
+def _start_distances(config, distance):
+    """``(name, d)`` for each flagellum: its name in messages and the smallest ``distance``
+    (a function of core-unit positions, in ``L``) of its starting beads, in metres."""
+    from flagwrap.geometry.helix import filament_positions
+
+    fil = config.filament
+    shape = filament_positions(fil, config.clamp) / fil.length
+    for k, pl in enumerate(placements_from_config(config) or [Placement()]):
+        where = f"flagellum[{k}]" if config.flagella else "the filament"
+        yield where, float(np.min(distance(pl.apply(shape)))) * fil.length
+
+
 def check_walls(config) -> None:
     """Refuse ``[[wall]]`` tables that cannot be run (one line naming the key, before any
     work): more than one wall, a free-swimming body beside one with the Krylov blob solver or
@@ -412,7 +424,6 @@ def check_walls(config) -> None:
     symmetry is broken), a filament that starts within its radius of the wall or behind it, a
     body across it."""
     from flagwrap.errors import UserInputError
-    from flagwrap.geometry.helix import filament_positions
 
     walls = config.walls
     if len(walls) > 1:
@@ -436,11 +447,8 @@ def check_walls(config) -> None:
                              "symmetry; use numerics.frame = 'lab' (or wall.normal = [0, 0, +-1])")
     fil = config.filament
     L, a = fil.length, fil.cross_section_radius
-    shape = filament_positions(fil, config.clamp) / L
-    for k, pl in enumerate(placements_from_config(config) or [Placement()]):
-        h = float(np.min(plane.heights(pl.apply(shape)))) * L
+    for where, h in _start_distances(config, plane.heights):
         if h < a:
-            where = f"flagellum[{k}]" if config.flagella else "the filament"
             raise UserInputError(
                 f"wall[0].point = {list(w.point)} m: {where} starts {h:.3g} m from the wall "
                 f"(on the side its normal points to), less than its radius a = {a:.3g} m: move "
@@ -481,7 +489,6 @@ def check_tubes(config) -> None:
     narrower than the body is allowed: whether the cell passes is the question), a filament or
     body that starts across the tube's wall."""
     from flagwrap.errors import UserInputError
-    from flagwrap.geometry.helix import filament_positions
 
     if len(config.tubes) > 1:
         raise UserInputError(f"{len(config.tubes)} [[tube]] tables: one tube is supported")
@@ -502,12 +509,8 @@ def check_tubes(config) -> None:
                              f"below the tube's narrowest radius {tube.narrowest * L:g} m")
     fil = config.filament
     a = fil.cross_section_radius
-    shape = filament_positions(fil, config.clamp) / L
-    for k, pl in enumerate(placements_from_config(config) or [Placement()]):
-        gap = tube.gap(pl.apply(shape))
-        g = float(np.min(gap)) * L
+    for where, g in _start_distances(config, tube.gap):
         if not g > a:
-            where = f"flagellum[{k}]" if config.flagella else "the filament"
             raise UserInputError(
                 f"tube[0]: {where} starts {g:.3g} m from the tube's wall (inside), less than "
                 f"its radius a = {a:.3g} m, or outside the tube: move the tube (tube.center) "
@@ -520,9 +523,8 @@ def check_tubes(config) -> None:
             raise UserInputError(f"tube[0].radius = {tube.radius * L:g} m: the cell body "
                                  f"(radius {rb:g} m) is as wide or wider; widen the tube")
         blobs, _ = cell_body_blobs(config)
-        g = float(np.min(tube.gap(blobs))) * L
-        if not g > 0.0:
-            raise UserInputError(f"tube[0]: the cell body crosses the tube's wall or lies "
+        if not np.min(tube.gap(blobs)) > 0.0:
+            raise UserInputError("tube[0]: the cell body crosses the tube's wall or lies "
                                  "outside the tube: move the tube (tube.center) or widen it "
                                  "(tube.radius)")
 

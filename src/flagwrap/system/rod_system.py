@@ -262,22 +262,16 @@ class RodSystem:
     def _config_interactions(self) -> list:
         c = self.config.contact
         out = []
-        if self.wall is not None:
-            from flagwrap.interactions.wall import WallContact, contact_law
+        if self.wall is not None or self.tube is not None:
+            from flagwrap.interactions.wall import TubeContact, WallContact, contact_law
 
-            active = np.ones(self.N, bool)
+            active = np.ones(self.N, bool)  # the joints' beads: the motor holds them
             for p in self.parts:
                 active[p.bead0:p.bead0 + p.nc] = False
             cutoff, strength, c2 = contact_law(self.config, self.bond)
-            out.append(WallContact(self.wall, cutoff, strength, active, c2=c2))
-        if self.tube is not None:
-            from flagwrap.interactions.wall import TubeContact, contact_law
-
-            active = np.ones(self.N, bool)
-            for p in self.parts:
-                active[p.bead0:p.bead0 + p.nc] = False
-            cutoff, strength, c2 = contact_law(self.config, self.bond)
-            out.append(TubeContact(self.tube, cutoff, strength, active, c2=c2))
+            for cls, boundary in ((WallContact, self.wall), (TubeContact, self.tube)):
+                if boundary is not None:
+                    out.append(cls(boundary, cutoff, strength, active, c2=c2))
         if not c.self_contact:
             return out
         from flagwrap.interactions.self_contact import SelfContact, SelfContactInteraction
