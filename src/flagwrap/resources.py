@@ -94,30 +94,48 @@ def estimate(config) -> Estimate:
 
 
 def _blob_cost(config, ny: int) -> tuple[int, float]:
-    """A no-slip body's blob count (its surface over a blob's share, ``spacing^2 sqrt(3)/2``
-    on a triangular lattice) and the memory its solver needs: the direct solver's factor and
-    inverse (two ``(3 n)^2`` matrices) and the beads x blobs block, or the Krylov solver's
-    O(n) blocks."""
+    """The fixed blobs' count, a no-slip body's (its surface over a blob's share,
+    ``spacing^2 sqrt(3)/2`` on a triangular lattice) and a ``[[tube]]``'s
+    (:meth:`flagwrap.confinement.tube.Tube.estimated_blobs`), and the memory their solver
+    needs: the direct solver's factor and inverse (two ``(3 n)^2`` matrices) and the beads x
+    blobs block, or the Krylov solver's O(n) blocks."""
+    n = _body_blobs(config) + _tube_blobs(config)
+    if n == 0:
+        return 0, 0.0
+    from flagwrap.body.solver import AUTO_DIRECT_MAX
+
+    b = config.body
+    direct = b.solver == "direct" or (b.solver == "auto" and n <= AUTO_DIRECT_MAX)
+    if direct:
+        return n, 2.0 * 8.0 * (3 * n) ** 2 + 8.0 * 3 * n * ny
+    return n, 200.0 * 8.0 * 3 * n
+
+
+def _body_blobs(config) -> int:
     b = config.body
     if not b.no_slip:
-        return 0, 0.0
+        return 0
     from flagwrap.body.shapes import config_shape
 
     mesh = config_shape(config).surface_mesh(48, 18)
     if mesh is None:
-        return 0, 0.0
+        return 0
     v, f = mesh
     tri = v[f]
     area = 0.5 * float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
                                       axis=1).sum())
     sp = b.resolved_blob_spacing(config.filament.helix_radius) / config.filament.length
-    n = int(area / (sp * sp * math.sqrt(3.0) / 2.0)) + 1
-    from flagwrap.body.solver import AUTO_DIRECT_MAX
+    return int(area / (sp * sp * math.sqrt(3.0) / 2.0)) + 1
 
-    direct = b.solver == "direct" or (b.solver == "auto" and n <= AUTO_DIRECT_MAX)
-    if direct:
-        return n, 2.0 * 8.0 * (3 * n) ** 2 + 8.0 * 3 * n * ny
-    return n, 200.0 * 8.0 * 3 * n
+
+def _tube_blobs(config) -> int:
+    if not (config.tubes and config.numerics.hydrodynamics):
+        return 0
+    from flagwrap.confinement.tube import BLOB_RADIUS_RATIO
+    from flagwrap.system.parts import config_tube
+
+    h = config.tubes[0].resolved_blob_spacing / config.filament.length
+    return config_tube(config).estimated_blobs(h, BLOB_RADIUS_RATIO * h)
 
 
 def _parse_bytes(text: str) -> float:
@@ -213,7 +231,13 @@ def check_memory(config, limit: float | None = None) -> Estimate:
     if est.memory <= limit:
         return est
     num, N = config.numerics, config.filament.n_beads
-    if est.blob_memory >= max(est.output_memory, est.linalg_memory):
+    if est.blob_memory >= max(est.output_memory, est.linalg_memory) and _tube_blobs(config) > \
+            _body_blobs(config):
+        cause = (f"the tube: about {est.blobs:.3g} blobs with tube[0].blob_spacing = "
+                 f"{config.tubes[0].resolved_blob_spacing:.3g} m need {_gb(est.blob_memory)} with "
+                 f"body.solver = {config.body.solver!r}; increase tube[0].blob_spacing or use "
+                 "body.solver = \"krylov\"")
+    elif est.blob_memory >= max(est.output_memory, est.linalg_memory):
         b = config.body
         cause = (f"the no-slip body: about {est.blobs:.3g} blobs at body.blob_spacing = "
                  f"{b.resolved_blob_spacing(config.filament.helix_radius):.3g} m need "

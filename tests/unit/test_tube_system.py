@@ -149,6 +149,13 @@ def test_config_round_trips():
     ("", "", TUBE + "colour = 'red'\n", r"unknown key tube\[0\]\.colour"),
     ("", "", TUBE.replace("blob_spacing = 0.025", "blob_spacing = -1.0"),
      r"tube\[0\]\.blob_spacing"),
+    # ~1e7 blobs: refused from the estimated count, before any blob is placed
+    ("", "", TUBE.replace("blob_spacing = 0.025", "blob_spacing = 0.0001"),
+     r"tube\[0\]\.blob_spacing = 0.0001 m puts ~\d+ blobs on the tube, more than the Krylov "
+     r"blob solve takes \(20000\)"),
+    ("", BODY + "solver = 'direct'\n", TUBE.replace("blob_spacing = 0.025", "blob_spacing = 0.005"),
+     r"tube\[0\]\.blob_spacing = 0.005 m puts ~\d+ blobs on the tube and the body, more than "
+     r"the direct blob solve takes \(4000\); .* or body.solver = 'krylov'"),
 ])
 def test_refusals_name_the_key(numerics, tables, tube, key):
     with pytest.raises(UserInputError, match=key):
@@ -161,3 +168,21 @@ def test_stability_refuses_a_tube_by_name():
     cfg = config_from_dict(tomllib.loads(_text()))
     with pytest.raises(UserInputError, match=r"\[\[tube\]\] is not available to flagwrap stability"):
         make_frame(cfg, 1.0)
+
+
+def test_memory_estimate_counts_the_tube_and_names_it():
+    """The tube's blobs join the blob solver: the estimate counts them (to the shell's count)
+    and, when they are what does not fit, the memory refusal names the tube's spacing."""
+    from flagwrap.body.solver import AUTO_DIRECT_MAX
+    from flagwrap.params import MAX_BLOBS
+    from flagwrap.resources import check_memory, estimate
+    from flagwrap.system.parts import tube_blobs
+
+    assert AUTO_DIRECT_MAX == MAX_BLOBS  # "auto" factorises whatever the direct solve takes
+    cfg = config_from_dict(tomllib.loads(_text()))
+    est = estimate(cfg)
+    assert est.blobs == pytest.approx(len(tube_blobs(cfg)[0]), rel=0.06)  # as the shell's test
+    assert est.blob_memory >= 2 * 8 * (3 * est.blobs) ** 2  # the factor and the inverse
+    with pytest.raises(UserInputError, match=r"the tube: about .* blobs with "
+                                             r"tube\[0\]\.blob_spacing = 0\.025 m need"):
+        check_memory(cfg, limit=0.5 * est.blob_memory)

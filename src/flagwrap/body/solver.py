@@ -12,7 +12,8 @@ The blobs do not move in the body's frame, so ``M_bb`` is the same for a whole r
   ordering), each cluster's own RPY block factorised. O(n block) memory, each solve a few tens
   of O(n^2) products; stops at the relative residual ``rtol``.
 
-``make_blob_solver(kind, ...)``: ``"auto"`` is direct up to ``AUTO_DIRECT_MAX`` blobs.
+``make_blob_solver(kind, ...)``: ``"auto"`` is direct up to ``AUTO_DIRECT_MAX`` blobs (the
+direct solve's limit), where the memory check of :mod:`flagwrap.resources` has priced it.
 Measured (benchmarks/swimmer.py): memory and time per solve against the number of blobs.
 """
 
@@ -25,8 +26,12 @@ from scipy.linalg.blas import dsymv as _symv
 from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, rpy_apply_radii
 from flagwrap.hydrodynamics.wall import wall_correction_apply, wall_correction_matrix
 
-#: most blobs for which "auto" takes the direct solver (a 1500-blob factor is 162 MB)
-AUTO_DIRECT_MAX = 1500
+#: most blobs for which "auto" takes the direct solver: params.MAX_BLOBS, the direct solve's
+#: own limit (a 4000-blob factor is 1.15 GB, ~2.2 GB at its peak). Below it the factor is
+#: the faster for every fixed set of blobs: a held S. putrefaciens body in a tube (1592
+#: blobs) factorises in 1.2 s and solves in 20 ms, where block-Jacobi CG takes 115-192
+#: iterations and 3-4 s a solve (docs/confinement.md, "Cost")
+AUTO_DIRECT_MAX = 4000
 KINDS = ("auto", "direct", "krylov")
 
 
@@ -35,12 +40,13 @@ class DirectBlobSolver:
 
     With the inverse a solve is one matrix-vector product: one pass over the n^2 numbers where
     the two triangular solves make two slower ones (344 blobs: 0.11 ms against 0.48 ms on one
-    core; the same to 4e-15). Above ``INVERSE_MAX`` blobs the inverse's memory (and its
-    temporaries: a 3875-blob body peaks at 5.5 GB with it, 2.2 GB without) outweighs that, and
-    the factor alone solves."""
+    core; 1592 blobs of a held body in a tube: 5.3 ms against 20.1 ms, for 2.2 s more to
+    build). Above ``INVERSE_MAX`` blobs the inverse's memory (and its temporaries: a 3875-blob
+    body peaks at 5.5 GB with it, 2.2 GB without) outweighs that, and the factor alone
+    solves; at 2500 blobs the inverse is 0.45 GB."""
 
     kind = "direct"
-    INVERSE_MAX = 1500
+    INVERSE_MAX = 2500
 
     def __init__(self, blobs: np.ndarray, radii: np.ndarray, wall=None, invert: bool = True):
         from scipy.linalg import lapack

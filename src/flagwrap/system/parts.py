@@ -507,6 +507,7 @@ def check_tubes(config) -> None:
     if t.resolved_blob_spacing >= tube.narrowest * L:
         raise UserInputError(f"tube[0].blob_spacing = {t.resolved_blob_spacing:g} m must be "
                              f"below the tube's narrowest radius {tube.narrowest * L:g} m")
+    _check_tube_blob_count(config, tube)
     fil = config.filament
     a = fil.cross_section_radius
     for where, g in _start_distances(config, tube.gap):
@@ -527,6 +528,32 @@ def check_tubes(config) -> None:
             raise UserInputError("tube[0]: the cell body crosses the tube's wall or lies "
                                  "outside the tube: move the tube (tube.center) or widen it "
                                  "(tube.radius)")
+
+
+def _check_tube_blob_count(config, tube) -> None:
+    """Refuse a tube whose blobs, with the body's, are more than its blob solver takes
+    (``MAX_BLOBS`` dense, ``MAX_BLOBS_KRYLOV`` by conjugate gradients), from the shell's
+    estimated count, before any blob is placed."""
+    from flagwrap.confinement.tube import BLOB_RADIUS_RATIO
+    from flagwrap.errors import UserInputError
+    from flagwrap.params import MAX_BLOBS, MAX_BLOBS_KRYLOV
+
+    L = config.filament.length
+    h = config.tubes[0].resolved_blob_spacing
+    n = tube.estimated_blobs(h / L, BLOB_RADIUS_RATIO * h / L)
+    if config.body.no_slip:
+        from flagwrap.body.multiblob import cell_body_blobs
+
+        n += len(cell_body_blobs(config)[0])
+    direct = config.body.solver == "direct"
+    most = MAX_BLOBS if direct else MAX_BLOBS_KRYLOV
+    if n > most:
+        raise UserInputError(
+            f"tube[0].blob_spacing = {h:g} m puts ~{n} blobs on the tube"
+            + (" and the body" if config.body.no_slip else "")
+            + f", more than the {'direct' if direct else 'Krylov'} blob solve takes ({most}); "
+            f"use a spacing >= {h * math.sqrt(n / most):.3g} m"
+            + (" or body.solver = 'krylov'" if direct else ""))
 
 
 def _min_segment_distance(x, z) -> float:
