@@ -2,6 +2,7 @@
 system that takes one runs inside it and stores it, its blobs screen the beads' flow, its
 contact is its energy's gradient, and every kind that does not take one is refused by name."""
 
+import math
 import tomllib
 
 import numpy as np
@@ -186,3 +187,32 @@ def test_memory_estimate_counts_the_tube_and_names_it():
     with pytest.raises(UserInputError, match=r"the tube: about .* blobs with "
                                              r"tube\[0\]\.blob_spacing = 0\.025 m need"):
         check_memory(cfg, limit=0.5 * est.blob_memory)
+
+
+@pytest.mark.parametrize("kind", ["lab", "fixed no-slip body"])
+def test_analyze_reports_the_gap_to_the_tube(kind, tmp_path, capsys):
+    # the straight tube's gap is R_t - r - a exactly, r each bead's distance from the axis
+    # (the z axis through x = y = 0 here), computed from the run's positions directly
+    from flagwrap.cli.main import main
+    from flagwrap.io.runfile import read_run
+
+    path = tmp_path / "t.toml"
+    path.write_text(_text(*KINDS[kind][:2], ccw=0.2, cw=0.1))
+    out = tmp_path / "t.nc"
+    assert main(["run", str(path), "-o", str(out), "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["analyze", str(out), "--json", "--no-write"]) == 0
+    import json
+
+    res = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    ds = read_run(out)
+    x = ds["position"].values
+    gap = 0.07 - np.hypot(x[..., 0], x[..., 1]) - 0.0015
+    w = res["wall"]
+    assert w["boundary"] == "tube"
+    assert w["gap_min"] == pytest.approx(gap.min(), rel=1e-12)
+    assert w["gap_final"] == pytest.approx(gap[-1].min(), rel=1e-12)
+    tip = ds["tip_position"].values[-1]
+    assert w["tip_axis_distance_final"] == pytest.approx(math.hypot(tip[0], tip[1]), rel=1e-12)
+    assert main(["analyze", str(out), "--no-write"]) == 0
+    assert "tube: closest bead surface" in capsys.readouterr().out

@@ -254,6 +254,34 @@ FREE_SPHERE = ("[body]\nsurface = 'no-slip'\nshape = 'sphere'\nradius = 0.05\n"
                "blob_spacing = 0.012\nmotion = 'free'\n")
 
 
+def test_analyze_reports_a_free_cell_beside_the_wall(tmp_path):
+    # the sphere's centre is its pole (the body's reference point, its lowest point in the
+    # body frame) plus its radius along the body axis: its height above the wall, the axis's
+    # angle to the plane and the speeds, computed here from the pose directly
+    from flagwrap.analysis.runfile_attrs import analyze_run_file
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.observables.swimming import quaternion_matrices
+    from flagwrap.simulation import simulate
+
+    cfg = _cfg(tables=FREE_SPHERE, ccw=0.2, cw=0.1)
+    path = write_run(simulate(cfg), tmp_path / "free.nc")
+    w = analyze_run_file(path, write=False)["wall"]
+    ds = read_run(path)
+    R = quaternion_matrices(ds["body_orientation"].values)
+    c = ds["body_position"].values + 0.05 * R[:, :, 2]
+    h = 0.08 - c[:, 0]  # the wall x = 0.08 faces -x
+    assert w["boundary"] == "wall"
+    assert w["body_height_final"] == pytest.approx(h[-1], rel=1e-9)
+    assert w["body_height_min"] == pytest.approx(h.min(), rel=1e-9)
+    assert w["body_tilt_final_deg"] == pytest.approx(math.degrees(math.asin(-R[-1, 0, 2])), abs=1e-9)
+    t = ds["time"].values
+    k = np.flatnonzero(t >= t[-1] - 2 * math.pi / cfg.scales.omega - 1e-12 * t[-1])
+    d = c[k[-1]] - c[k[0]]
+    dt = t[k[-1]] - t[k[0]]
+    assert w["speed_normal"] == pytest.approx(-d[0] / dt, rel=1e-9)
+    assert w["speed_parallel"] == pytest.approx(math.hypot(d[1], d[2]) / dt, rel=1e-9)
+
+
 @pytest.mark.parametrize("h", [1.5, 2.0, 4.0])
 def test_free_cells_mobility_beside_a_wall_is_brenners(h):
     # the swimmer's own body mobility at its pose, a 212-blob sphere with a wall above it

@@ -204,8 +204,9 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
     res["swimming"] = swimming_summary(ds, final_turns=a.final.final_turns)
     from flagwrap.observables.wall import wall_summary
 
-    wall = wall_summary(ds)
-    res["wall"] = None if wall is None else {k: v for k, v in wall.items() if k != "gap_series"}
+    wall = wall_summary(ds, final_turns=a.final.final_turns)
+    res["wall"] = None if wall is None else {k: v for k, v in wall.items()
+                                             if k not in ("gap_series", "body_height")}
     from flagwrap.observables.polymorph import polymorph_summaries
 
     poly = polymorph_summaries(ds)  # one per flagellum

@@ -139,10 +139,8 @@ def run(args) -> int:
                   "threshold (a transient, or a decaying wobble on a soft hook); 'buckled' is the "
                   "paper's rule (docs/analysis.md)")
         if res.get("wall"):
-            w = res["wall"]
-            print(f"  wall: closest bead surface {w['gap_min']:+.3g} m from it (at turn "
-                  f"{w['gap_min_turns']:.2f}), {w['gap_final']:+.3g} m at the end; free end "
-                  f"{w['tip_height_final']:.3g} m above it")
+            for line in boundary_lines(res["wall"]):
+                print("  " + line)
         if res.get("polymorph"):
             pm = res["polymorph"]
             many = res.get("polymorph_filaments") or [pm]
@@ -158,10 +156,26 @@ def run(args) -> int:
             print(f"  swimming, {what} ({ph['t0']:.3g}-{ph['t1']:.3g} s): "
                   f"speed {ph['speed'] * 1e6:+.4g} um/s (+ body first), body rotation "
                   f"{ph['body_rotation_hz']:+.4g} Hz, motor {ph['motor_rate_hz']:+.4g} Hz, "
-                  f"{ph['displacement_per_turn'] * 1e9:+.4g} nm per motor turn")
+                  f"{ph['displacement_per_turn'] * 1e9:+.4g} nm per motor turn, motor power "
+                  f"{ph['motor_power']:.4g} W, Lighthill efficiency "
+                  f"{ph['efficiency'] * 100:.3g} %")
         print(f"  not stored (--no-store): {path} unchanged" if args.no_write
               else f"  {stored_line(path)}")
     return 0
+
+
+def boundary_lines(w: dict) -> list[str]:
+    """The wall's or tube's lines (:func:`flagwrap.observables.wall.wall_summary`)."""
+    where = (f"free end {w['tip_height_final']:.3g} m above it" if w["boundary"] == "wall" else
+             f"free end {w['tip_axis_distance_final']:.3g} m from its axis")
+    out = [f"{w['boundary']}: closest bead surface {w['gap_min']:+.3g} m from it (at turn "
+           f"{w['gap_min_turns']:.2f}), {w['gap_final']:+.3g} m at the end; {where}"]
+    if "body_height_final" in w:
+        out.append(f"{w['boundary']}: body centre {w['body_height_final']:.3g} m above it at the "
+                   f"end (closest {w['body_height_min']:.3g} m), axis {w['body_tilt_final_deg']:+.1f} "
+                   f"deg to its plane; last turns: {w['speed_parallel'] * 1e6:.4g} um/s along it, "
+                   f"{w['speed_normal'] * 1e6:+.3g} um/s away from it")
+    return out
 
 
 def polymorph_line(p: dict) -> str:

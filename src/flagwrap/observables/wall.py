@@ -1,30 +1,85 @@
-"""Where the filament is against a plane wall (``[[wall]]``; docs/confinement.md), from a run
-file's positions: the gap between each bead's surface and the wall (its centre's height above
-the plane less the filament's radius ``a``), its smallest value over the run and at the end,
-and the free end's height above the wall."""
+"""Where the filament and the cell are against a boundary (``[[wall]]`` or ``[[tube]]``;
+docs/confinement.md, "Observables"), from a run file's positions.
+
+* Every run: the gap between each bead's surface and the boundary (its centre's distance
+  to it less the filament's radius ``a``; for a tube :meth:`flagwrap.confinement.tube.Tube.gap`),
+  its smallest value over the run and at the end, and the free end's distance from the
+  boundary: its height above a wall, its distance from a tube's axis.
+* A free cell beside a wall: its body centre's height above the wall over the run, the angle
+  of its axis to the wall's plane at the end, and over the last turns its speed parallel
+  to the wall and towards it (the body centre's displacement over the window, as
+  :func:`flagwrap.observables.swimming.phase_summary` measures the swimming speed).
+"""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
 
-def wall_summary(ds) -> dict | None:
-    """``None`` for a run without a wall; else ``gap_min`` [m] (smallest bead gap over the
-    run, negative: a bead's surface past the plane, which contact resists), ``gap_min_turns``
-    (when), ``gap_final`` [m] (the last frame's), ``tip_height_final`` [m] (the first
-    flagellum's free end above the wall), ``gap_series`` (time,) [m]."""
+def wall_summary(ds, final_turns: float = 1.0) -> dict | None:
+    """``None`` for a run without a wall or tube; else ``boundary`` ("wall" or "tube"),
+    ``gap_min`` [m] (smallest bead gap over the run, negative: a bead's surface past the
+    boundary, which contact resists), ``gap_min_turns`` (when), ``gap_final`` [m] (the last
+    frame's), ``gap_series`` (time,) [m], and ``tip_height_final`` [m] (wall: the first
+    flagellum's free end above it) or ``tip_axis_distance_final`` [m] (tube: from its axis).
+    A free cell beside a wall adds ``body_height`` (time,) [m] (its centre above the wall),
+    ``body_height_final``, ``body_height_min`` [m], ``body_tilt_final_deg`` (its axis to the
+    wall's plane, + pointing away from the wall), and over the last ``final_turns`` reference
+    turns ``speed_parallel`` and ``speed_normal`` [m/s] (+ away from the wall)."""
     from flagwrap.io.runfile import config_of
 
     cfg = config_of(ds)
-    if not cfg.walls:
+    if not (cfg.walls or cfg.tubes):
         return None
-    w = cfg.walls[0]
-    n, p = w.unit_normal, np.asarray(w.point, float)
+    a = cfg.filament.cross_section_radius
     x = ds["position"].values  # (time, bead, xyz), lab frame [m]
-    gap = (x - p) @ n - cfg.filament.cross_section_radius
+    tip = ds["tip_position"].values
+    if cfg.walls:
+        w = cfg.walls[0]
+        n, p = w.unit_normal, np.asarray(w.point, float)
+        gap = (x - p) @ n - a
+        out = {"boundary": "wall", "tip_height_final": float((tip[-1] - p) @ n)}
+    else:
+        tube = cfg.tubes[0].geometry(1.0)  # in metres
+        gap = tube.gap(x.reshape(-1, 3)).reshape(x.shape[:2]) - a
+        out = {"boundary": "tube",
+               "tip_axis_distance_final": float(tube.cylindrical(tip[-1:])[1][0])}
     series = gap.min(axis=1)
     k = int(np.argmin(series))
-    return {"gap_min": float(series[k]), "gap_min_turns": float(ds["turns"].values[k]),
-            "gap_final": float(series[-1]),
-            "tip_height_final": float((ds["tip_position"].values[-1] - p) @ n),
-            "gap_series": series}
+    out.update(gap_min=float(series[k]), gap_min_turns=float(ds["turns"].values[k]),
+               gap_final=float(series[-1]), gap_series=series)
+    if cfg.walls and "body_position" in ds.variables:
+        out.update(_free_body_beside_wall(ds, cfg, n, p, final_turns))
+    return out
+
+
+def body_centre(config) -> np.ndarray:
+    """The cell body's centre in its own frame [m]: the mean of its blob shell (the shell
+    is symmetric about the centre for every shape)."""
+    from flagwrap.body.multiblob import cell_body_blobs
+
+    return cell_body_blobs(config)[0].mean(axis=0) * config.filament.length
+
+
+def _free_body_beside_wall(ds, cfg, n, p, final_turns: float) -> dict:
+    from flagwrap.observables.swimming import quaternion_matrices
+
+    R = quaternion_matrices(ds["body_orientation"].values)
+    c = ds["body_position"].values + R @ body_centre(cfg)  # (time, 3) lab centres
+    h = (c - p) @ n
+    t = ds["time"].values
+    T = 1.0 / cfg.scales.omega
+    t1 = float(t[-1])
+    k = np.flatnonzero(t >= max(float(t[0]), t1 - 2 * math.pi * final_turns * T) - 1e-12 * t1)
+    i, j = k[0], k[-1]
+    d = c[j] - c[i]
+    dt = t[j] - t[i]
+    normal = float(d @ n)
+    axis = R[-1][:, 2]
+    return {"body_height": h, "body_height_final": float(h[-1]),
+            "body_height_min": float(h.min()),
+            "body_tilt_final_deg": math.degrees(math.asin(max(-1.0, min(1.0, float(axis @ n))))),
+            "speed_parallel": float(np.linalg.norm(d - normal * n) / dt) if dt > 0 else math.nan,
+            "speed_normal": normal / dt if dt > 0 else math.nan}
