@@ -152,6 +152,8 @@ def test_analyze_and_its_figure_on_a_free_cell_with_two_flagella(tmp_path, capsy
     assert main(["analyze", str(path), "--json", "--figure", str(png)]) == 0
     res = json.loads(capsys.readouterr().out)
     assert len(res["filaments"]) == 2 and "separation" in res["bundle"]
+    # both motors' power (each torque times its own rate) and an efficiency below one
+    assert all(p["motor_power"] > 0 and 0 < p["efficiency"] < 1 for p in res["swimming"])
     assert png.is_file() and png.stat().st_size > 10_000
     from flagwrap.io.runfile import read_run
 
