@@ -63,6 +63,22 @@ def test_estimated_blob_count_is_the_shells(tube, h):
     assert tube.estimated_blobs(h, BLOB_RADIUS_RATIO * h) == pytest.approx(n, rel=0.06)
 
 
+@pytest.mark.parametrize("closed", [False, True])
+def test_surface_mesh_lies_on_the_wall_and_is_watertight_when_closed(closed):
+    t = Tube(1.0, 6.0, center=(0.1, 0.2, 0.3), axis=(1.0, 1.0, 0.0), constriction_radius=0.4,
+             constriction_length=2.0, closed=closed)
+    v, f = t.surface_mesh(24)
+    s, r = t.cylindrical(v)
+    R, _, _ = t.profile(s)
+    side = r > 1e-12
+    assert np.allclose(r[side], R[side], atol=1e-12)  # every wall vertex on R(s)
+    assert f.min() >= 0 and f.max() == len(v) - 1
+    # every edge shared by two triangles when closed; the open tube's end rings once
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    _, count = np.unique(e, axis=0, return_counts=True)
+    assert set(count) == ({2} if closed else {1, 2})
+
+
 @pytest.mark.parametrize("kw, key", [
     (dict(radius=0.0, length=1.0), "tube.radius"),
     (dict(radius=1.0, length=-1.0), "tube.length"),

@@ -216,3 +216,20 @@ def test_analyze_reports_the_gap_to_the_tube(kind, tmp_path, capsys):
     assert w["tip_axis_distance_final"] == pytest.approx(math.hypot(tip[0], tip[1]), rel=1e-12)
     assert main(["analyze", str(out), "--no-write"]) == 0
     assert "tube: closest bead surface" in capsys.readouterr().out
+
+
+def test_vtk_export_draws_the_tube(tmp_path):
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.io.vtk import export_vtk
+    from flagwrap.simulation import simulate
+
+    cfg = config_from_dict(tomllib.loads(_text(ccw=0.1, cw=0.1)))
+    ds = read_run(write_run(simulate(cfg), tmp_path / "t.nc"))
+    pvd = export_vtk(ds, tmp_path / "vtk", with_forces=False)
+    assert 'part="2" file="boundary.vtp"' in pvd.read_text()
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(tmp_path / "vtk" / "boundary.vtp").getroot()
+    pts = np.array(root.find(".//Points/DataArray").text.split(), float).reshape(-1, 3)
+    assert np.allclose(np.hypot(pts[:, 0], pts[:, 1]), 0.07, atol=1e-12)  # on the wall
+    assert pts[:, 2].min() == pytest.approx(-0.45) and pts[:, 2].max() == pytest.approx(0.05)

@@ -364,3 +364,21 @@ def test_stability_refuses_a_free_cell_beside_a_wall(tmp_path, capsys):
     assert main(["stability", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no steady whirl" in err[0]
+
+
+def test_vtk_export_draws_the_wall_under_the_run(tmp_path):
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.io.vtk import export_vtk
+    from flagwrap.simulation import simulate
+
+    ds = read_run(write_run(simulate(_cfg(ccw=0.1, cw=0.1)), tmp_path / "w.nc"))
+    pvd = export_vtk(ds, tmp_path / "vtk", with_forces=False)
+    assert 'part="2" file="boundary.vtp"' in pvd.read_text()
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(tmp_path / "vtk" / "boundary.vtp").getroot()
+    pts = np.array(root.find(".//Points/DataArray").text.split(), float).reshape(-1, 3)
+    assert np.allclose(pts[:, 0], 0.08, atol=1e-14)  # the plane x = 0.08
+    x = ds["position"].values.reshape(-1, 3)  # the square covers every bead's foot
+    assert (pts[:, 1].min() < x[:, 1].min() and pts[:, 1].max() > x[:, 1].max()
+            and pts[:, 2].min() < x[:, 2].min() and pts[:, 2].max() > x[:, 2].max())

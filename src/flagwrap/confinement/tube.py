@@ -165,6 +165,37 @@ class Tube:
         """How far outside the surface the blob centres sit: ``BLOB_INSET`` blob radii."""
         return BLOB_INSET * blob_radius
 
+    def surface_mesh(self, n_around: int = 48, n_along: int | None = None):
+        """Its wall as triangles, for drawing (ParaView): vertices (m, 3) on ``R(s)`` at
+        ``n_along`` stations (default: the spacing of ``n_around`` points round the narrowest
+        ring, at most 400) and faces (k, 3); closed ends add a fan of triangles each."""
+        if n_along is None:
+            step = 2 * math.pi * self.narrowest / n_around
+            n_along = int(min(400, max(8, math.ceil(self.length / step) + 1)))
+        ss = np.linspace(-0.5 * self.length, 0.5 * self.length, n_along)
+        R, _, _ = self.profile(ss)
+        e1, e2, a = self.frame()
+        ang = 2 * math.pi * np.arange(n_around) / n_around
+        ring = np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2  # (n_around, 3)
+        v = (ss[:, None, None] * a + R[:, None, None] * ring[None]).reshape(-1, 3)
+        i, j = np.meshgrid(np.arange(n_along - 1), np.arange(n_around), indexing="ij")
+        p00 = i * n_around + j
+        p01 = i * n_around + (j + 1) % n_around
+        p10 = p00 + n_around
+        p11 = p01 + n_around
+        f = np.concatenate([np.stack([p00, p10, p11], -1).reshape(-1, 3),
+                            np.stack([p00, p11, p01], -1).reshape(-1, 3)])
+        if self.closed:
+            faces, pts = [f], [v]
+            for k, s_end in ((0, ss[0]), (n_along - 1, ss[-1])):
+                c = len(np.concatenate(pts))
+                pts.append((s_end * a)[None])
+                jj = np.arange(n_around)
+                faces.append(np.column_stack([np.full(n_around, c), k * n_around + jj,
+                                              k * n_around + (jj + 1) % n_around]))
+            v, f = np.concatenate(pts), np.concatenate(faces)
+        return np.asarray(self.center) + v, f
+
     def estimated_blobs(self, spacing: float, blob_radius: float) -> int:
         """About how many blobs :meth:`blob_shell` puts at ``spacing``: the area of the
         surface the blob centres lie on (``int 2 pi r sqrt(1 + r'^2) ds``, ``r`` the wall

@@ -6,6 +6,7 @@ Written by hand (ASCII VTK XML, format 0.1), so no VTK library is needed. Layout
     DIR/filament_0000.vtp  one polyline per saved frame (N points, one line cell)
     DIR/body.vtp           the cell body as a closed triangle surface (if the run has a body;
                            a free swimmer's moves: DIR/body_NNNN.vtp, one per frame)
+    DIR/boundary.vtp       a [[wall]]'s plane (a square under the run) or a [[tube]]'s wall
 
 Time values in the .pvd are ``t/T`` (the paper's clock) by default, or seconds. Coordinates are
 in metres, body axis +z, clamp at the origin (see :mod:`flagwrap.io.runfile`).
@@ -359,9 +360,36 @@ def export_vtk(ds, directory, time_unit: str = "turns", stride: int = 1,
             name = f"body_{i:0{width}d}.vtp"
             _write(d / name, polydata_xml(v @ poses[1][i].T + poses[0][i], polys=f))
             entries.append((float(tvals[i]), 1, name))
+    bv, bf = boundary_mesh(config_of(ds), X)
+    if bv is not None:  # the wall or the tube, still: one file for every frame
+        _write(d / "boundary.vtp", polydata_xml(bv, polys=bf))
+        entries += [(float(tvals[i]), 2, "boundary.vtp") for i in idx]
     pvd = d / "run.pvd"
     _write(pvd, pvd_xml(entries))  # last: a complete .pvd names only complete frames
     return pvd
+
+
+def boundary_mesh(config, positions, n_around: int = 48):
+    """The config's boundary as triangles in metres, or ``(None, None)``: a ``[[tube]]``'s
+    wall (:meth:`flagwrap.confinement.tube.Tube.surface_mesh`), or a ``[[wall]]``'s plane as
+    a square (two triangles) centred under the beads' mean position over the run, its side
+    three times their largest distance from it (at least three filament lengths)."""
+    if config.tubes:
+        return config.tubes[0].geometry(1.0).surface_mesh(n_around)
+    if not config.walls:
+        return None, None
+    w = config.walls[0]
+    n, p = w.unit_normal, np.asarray(w.point, float)
+    x = np.asarray(positions, float).reshape(-1, 3)
+    c = x.mean(axis=0)
+    c = c - ((c - p) @ n) * n
+    half = 1.5 * max(float(np.linalg.norm(x - c, axis=1).max()), 2.0 * config.filament.length)
+    t = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = t - (t @ n) * n
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    v = np.array([c + half * (su * e1 + sv * e2) for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+    return v, np.array([[0, 1, 2], [0, 2, 3]])
 
 
 def _write(path, text: str) -> None:
