@@ -233,3 +233,32 @@ def test_vtk_export_draws_the_tube(tmp_path):
     pts = np.array(root.find(".//Points/DataArray").text.split(), float).reshape(-1, 3)
     assert np.allclose(np.hypot(pts[:, 0], pts[:, 1]), 0.07, atol=1e-12)  # on the wall
     assert pts[:, 2].min() == pytest.approx(-0.45) and pts[:, 2].max() == pytest.approx(0.05)
+
+
+def test_movies_and_snapshots_draw_the_tubes_silhouette(tmp_path):
+    # a tube along z of radius 0.07 seen side-on by both cameras: two lines at u = -0.07 and
+    # +0.07 over its length; a tube along x is a circle of its radius for the camera on x
+    from flagwrap.plotting.render import CAMERAS, boundary_lines
+
+    cfg = config_from_dict(tomllib.loads(_text()))
+    for cam in CAMERAS:
+        lines = boundary_lines(cfg, cam)
+        assert sorted(round(float(u.mean()), 12) for u, _ in lines) == [-0.07, 0.07]
+        assert all(np.ptp(u) < 1e-12 and v.min() == pytest.approx(-0.45)
+                   and v.max() == pytest.approx(0.05) for u, v in lines)
+    from types import SimpleNamespace
+
+    from flagwrap.params import TubeWall
+
+    along_x = SimpleNamespace(tubes=(TubeWall(radius=0.3, length=0.9, center=(0.0, 0.0, -0.2),
+                                              axis=(1.0, 0.0, 0.0)),), walls=())
+    (u, v), = boundary_lines(along_x, CAMERAS[0])
+    assert np.allclose(np.hypot(u, v + 0.2), 0.3)
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.plotting.snapshots import snapshot_figure
+
+    ds = read_run(write_run(__import__("flagwrap.simulation").simulation.simulate(
+        config_from_dict(tomllib.loads(_text(ccw=0.1, cw=0.1)))), tmp_path / "t.nc"))
+    fig = snapshot_figure(ds, n=2)
+    grey = [ln for ax in fig.axes for ln in ax.lines if ln.get_color() == "0.55"]
+    assert len(grey) == 2 * 2 * 2  # two lines, two cameras, two panels

@@ -382,3 +382,14 @@ def test_vtk_export_draws_the_wall_under_the_run(tmp_path):
     x = ds["position"].values.reshape(-1, 3)  # the square covers every bead's foot
     assert (pts[:, 1].min() < x[:, 1].min() and pts[:, 1].max() > x[:, 1].max()
             and pts[:, 2].min() < x[:, 2].min() and pts[:, 2].max() > x[:, 2].max())
+
+
+def test_movies_and_snapshots_draw_the_wall_seen_edge_on():
+    # the wall x = 0.08 faces camera C1 (no edge to draw) and is edge-on to C2, whose image
+    # axis is -x: the line u = -0.08
+    from flagwrap.plotting.render import CAMERAS, boundary_lines
+
+    cfg = _cfg()
+    assert boundary_lines(cfg, CAMERAS[0]) == []
+    (u, v), = boundary_lines(cfg, CAMERAS[1])
+    assert np.allclose(u, -0.08) and np.ptp(v) > 10 * cfg.filament.length

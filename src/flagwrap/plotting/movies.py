@@ -158,7 +158,12 @@ class MovieFrames:
         # two camera views on the left ~2/3, traces on the right
         self.ax_views = [fig.add_axes((0.01, 0.02, 0.31, 0.88)), fig.add_axes((0.33, 0.02, 0.31, 0.88))]
         bar = nice_scale_bar(self.ulim[1] - self.ulim[0])
+        from flagwrap.io.runfile import config_of
+        from flagwrap.plotting.render import draw_boundary
+
+        cfg = config_of(ds)
         for k, (ax, cam) in enumerate(zip(self.ax_views, CAMERAS)):
+            draw_boundary(ax, cfg, cam)  # still: drawn once, behind the frames
             style_view(ax, self.ulim, self.zlim, title=cam.name, scale_bar=bar if k == 0 else None,
                        length=self.scene.length)
         turns = ds["turns"].values

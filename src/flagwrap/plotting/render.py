@@ -121,6 +121,49 @@ def scene_of(ds) -> Scene:
                  tuple((s.start, s.stop) for s in sl) if len(sl) > 1 else ())
 
 
+def boundary_lines(config, camera: Camera, n: int = 200) -> list:
+    """The config's wall or tube as the camera sees it, polylines ``(u, v)`` [m] to draw
+    behind the filament: a tube's two silhouette lines, ``R(s)`` either side of its axis
+    along ``toward x axis`` (exact for a straight tube, the profile's radius for a
+    constriction), or the circle of its radius seen end-on; a wall's edge when the camera
+    looks along its plane (a wall seen face-on has no edge in the view: nothing). Empty
+    without a boundary."""
+    right, toward = np.asarray(camera.right, float), np.asarray(camera.toward, float)
+
+    def image(p):
+        return np.stack([p @ right, p[..., 2]])
+
+    if config.tubes:
+        t = config.tubes[0].geometry(1.0)
+        a, c = np.asarray(t.axis), np.asarray(t.center)
+        q = np.cross(toward, a)
+        if np.linalg.norm(q) < 1e-9:  # seen end-on: its wall is a circle
+            e1, e2 = right, np.array([0.0, 0.0, 1.0])
+            ang = np.linspace(0.0, 2 * np.pi, n)
+            return [image(c + t.radius * (np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2))]
+        q /= np.linalg.norm(q)
+        ss = np.linspace(-0.5 * t.length, 0.5 * t.length, n)
+        R, _, _ = t.profile(ss)
+        mid = c + ss[:, None] * a
+        return [image(mid + sign * R[:, None] * q) for sign in (1.0, -1.0)]
+    if config.walls:
+        w = config.walls[0]
+        nrm, p = w.unit_normal, np.asarray(w.point, float)
+        d = np.cross(nrm, toward)
+        if abs(nrm @ toward) > 1e-9 or np.linalg.norm(d) < 1e-12:
+            return []
+        d /= np.linalg.norm(d)
+        span = 100.0 * config.filament.length
+        return [image(p + np.outer([-span, span], d))]
+    return []
+
+
+def draw_boundary(ax, config, camera: Camera) -> None:
+    """:func:`boundary_lines` into ``ax``, grey and behind the filament."""
+    for u, v in boundary_lines(config, camera):
+        ax.plot(u, v, color="0.55", lw=0.8, zorder=0)
+
+
 def body_poses(ds):
     """A free swimmer's body poses per saved frame, ``(X (F, 3) [m], R (F, 3, 3))`` (body to
     lab), or ``None`` for a fixed body (at the origin, axis +z)."""

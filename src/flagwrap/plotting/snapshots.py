@@ -107,9 +107,14 @@ def snapshot_figure(ds, times=None, n: int = 6, panel_width: float = 1.3, title:
                              squeeze=False)
     rend = Renderer(scene, **(renderer_kwargs or {}))
     bar = nice_scale_bar(ulim[1] - ulim[0], fraction=0.4)  # a bar one can read at strip size
+    from flagwrap.io.runfile import config_of
+    from flagwrap.plotting.render import draw_boundary
+
+    cfg = config_of(ds)
     for j, i in enumerate(idx):
         for r, cam in enumerate(CAMERAS):
             ax = axes[r, j]
+            draw_boundary(ax, cfg, cam)
             rend.draw(ax, X[i], cam, None if poses is None else (poses[0][i], poses[1][i]),
                       None if order is None else order[i])
             sense = "CW" if om[i] < 0 else ("CCW" if om[i] > 0 else "stop")
