@@ -31,11 +31,10 @@ import numpy as np
 
 
 def turn() -> None:
+    from flagwrap.cases import case_files
     from flagwrap.io.config import load_config
     from flagwrap.params import Phase, TubeWall
     from flagwrap.simulation import Simulation, make_system
-
-    from flagwrap.cases import case_files
 
     base = load_config(case_files()["s_putrefaciens_50hz_held"])
     base = base.replace(motor=dataclasses.replace(base.motor, protocol=(Phase("ccw", 1.0),)))
