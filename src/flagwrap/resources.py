@@ -98,7 +98,7 @@ def _blob_cost(config, ny: int) -> tuple[int, float]:
     ``spacing^2 sqrt(3)/2`` on a triangular lattice) and a ``[[tube]]``'s
     (:meth:`flagwrap.confinement.tube.Tube.estimated_blobs`), and the memory their solver
     needs: the direct solver's factor and inverse (two ``(3 n)^2`` matrices) and the beads x
-    blobs block, or the Krylov solver's O(n) blocks."""
+    blobs block, or the Krylov solver's blocks and coarse space."""
     n = _body_blobs(config) + _tube_blobs(config)
     if n == 0:
         return 0, 0.0
@@ -108,7 +108,9 @@ def _blob_cost(config, ny: int) -> tuple[int, float]:
     direct = b.solver == "direct" or (b.solver == "auto" and n <= AUTO_DIRECT_MAX)
     if direct:
         return n, 2.0 * 8.0 * (3 * n) ** 2 + 8.0 * 3 * n * ny
-    return n, 200.0 * 8.0 * 3 * n
+    # Krylov (body.solver.KrylovBlobSolver): CG vectors, the overlapping blocks' factors
+    # (about 2.5 x 64 blobs each, n / 64 of them) and the coarse space's A Z (9 n^2 / 64)
+    return n, 200.0 * 8.0 * 3 * n + 8.0 * (3 * 160) ** 2 * n / 64 + 8.0 * 9 * n * n / 64
 
 
 def _body_blobs(config) -> int:

@@ -407,7 +407,9 @@ def test_the_estimate_prices_a_no_slip_body_and_names_its_spacing():
                                              r"body.blob_spacing = .* body.solver = 'direct'"):
         check_memory(fine, limit=0.5 * estimate(fine).blob_memory)
     krylov = fine.replace(body=dataclasses.replace(fine.body, solver="krylov"))
-    assert estimate(krylov).blob_memory < 0.01 * estimate(fine).blob_memory
+    # the Krylov solver's overlapping blocks (O(n)) and coarse block (9 n^2 / 64 against
+    # the direct 18 n^2): 7 % of the direct memory at these ~3600 blobs, less with more
+    assert estimate(krylov).blob_memory < 0.15 * estimate(fine).blob_memory
 
 
 def test_sigterm_stops_a_critical_search_without_a_traceback(tmp_path):
