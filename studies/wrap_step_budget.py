@@ -9,7 +9,9 @@ error's max-norm (``DofLayout.scaled_error``) decomposed at each attempt: the un
 largest ``|err_i| / w_i`` and its block (``x``: a bead's position, ``theta``: a twist angle,
 ``body_x``/``body_q``: the pose, ...). For a bead, its centre's distance to the body's surface
 in units of the filament radius ``a`` (body frame for a free cell): "at the body" when below
-``--contact`` a (the contact law's range is ``a (1 + range)``), "free" otherwise.
+``--contact`` a (the contact law's range is ``a (1 + range)``), "near the body" below 10 a,
+"at the filament" when another bead of the chain (not one of its three neighbours each side)
+is within twice ``--contact`` a (self-contact), "free" otherwise.
 
 Prints, per ``--bin`` reference turns: attempts, rejections, the median step size and the
 share of attempts whose error was set by a bead at the body, a free bead, a twist angle or the
@@ -74,9 +76,19 @@ def main(argv=None) -> int:
                 cat = b.name
         if cat == "x":
             k = (i - xb.start) // 3
-            x = y_new[xb.slice].reshape(-1, 3)[k]
-            d = float(shape.distance(x[None])[0]) / a
-            cat = "bead at the body" if d < args.contact else "free bead"
+            xs = y_new[xb.slice].reshape(-1, 3)
+            d = float(shape.distance(xs[k][None])[0]) / a
+            far = np.abs(np.arange(len(xs)) - k) > 3  # not its chain neighbours
+            dself = (float(np.min(np.linalg.norm(xs[far] - xs[k], axis=1))) / a
+                     if far.any() else np.inf)
+            if d < args.contact:
+                cat = "bead at the body"
+            elif d < 10.0:
+                cat = "bead near the body"
+            elif dself < 2 * args.contact:
+                cat = "bead at the filament"
+            else:
+                cat = "free bead"
         log.append((h, err, res.accepted, cat))
         return res
 
@@ -97,13 +109,14 @@ def main(argv=None) -> int:
     hs = np.array([h for h, *_ in log]) / (2 * math.pi)
     acc = np.array([r[2] for r in log])
     cats = np.array([r[3] for r in log])
-    names = ["bead at the body", "free bead", "theta", "body_x", "body_q", "phi", "other"]
+    names = ["bead at the body", "bead near the body", "bead at the filament", "free bead",
+             "theta", "body_x", "body_q", "phi", "other"]
     names = [n for n in names if (cats == n).any()]
 
     def row(label, m):
         if not m.any():
             return
-        share = "  ".join(f"{n} {100 * np.mean(cats[m] == n):4.0f}%" for n in names)
+        share = "  ".join(f"{n} {100 * np.mean(cats[m] == n):3.0f}%" for n in names)
         print(f"{label:>16} {m.sum():>7} {np.sum(~acc[m]):>7} {np.median(hs[m & acc]) if (m & acc).any() else float('nan'):>10.2e}  {share}")
 
     print(f"{'turns':>16} {'attempts':>7} {'rejected':>7} {'median h/T':>10}  error set by")
