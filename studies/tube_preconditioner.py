@@ -14,38 +14,16 @@ Prints the iterations and times of both and their solutions' difference.
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 
-import numba as nb
 import numpy as np
 import scipy.linalg as sla
 from scipy.spatial import cKDTree
 
+from flagwrap.body.solver import _cluster_sums as cluster_sums
 from flagwrap.confinement.tube import Tube
-from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, _pair, rpy_apply_radii
-
-
-@nb.njit(cache=True)
-def cluster_sums(x, radii, cl, out):
-    """``out[3 i + a, 3 c + b] = sum_{j in cluster c} M_ij[a, b]``: the columns of ``A Z``."""
-    n = x.shape[0]
-    for i in range(n):
-        for j in range(n):
-            c = cl[j]
-            if i == j:
-                s = 1.0 / (6.0 * math.pi * radii[i])
-                for a in range(3):
-                    out[3 * i + a, 3 * c + a] += s
-                continue
-            d = (x[i, 0] - x[j, 0], x[i, 1] - x[j, 1], x[i, 2] - x[j, 2])
-            r = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-            f, g = _pair(r, radii[i], radii[j])
-            g /= r * r
-            for a in range(3):
-                for b in range(3):
-                    out[3 * i + a, 3 * c + b] += g * d[a] * d[b] + (f if a == b else 0.0)
+from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, rpy_apply_radii
 
 
 def clusters(b, r, block):
