@@ -337,11 +337,10 @@ def test_polymorph_summary_reads_a_known_front(tmp_path):
     assert res["fraction_b_final"] == pytest.approx(np.mean(sm < front[-1]), abs=1e-12)
 
 
-def test_cli_analyze_reports_the_polymorph_and_stability_refuses_a_free_one(tmp_path, capsys):
+def test_cli_analyze_reports_the_polymorph_and_stability_refuses_two_flagella(tmp_path, capsys):
     """``flagwrap analyze`` prints the polymorph line of a polymorph run (and none for a
-    fixed-shape one); ``flagwrap stability`` refuses a polymorph config on a free cell by
-    name, exit 2,
-    before any work."""
+    fixed-shape one); ``flagwrap stability`` refuses a polymorph config with two flagella by
+    name, exit 2, before any work (its turning frame needs one on the motor axis)."""
     from flagwrap.cli.main import main
 
     body = "[body]\nenabled = true\n"
@@ -355,12 +354,10 @@ def test_cli_analyze_reports_the_polymorph_and_stability_refuses_a_free_one(tmp_
         assert main(["analyze", str(out), "--no-store"]) == 0
         text = capsys.readouterr().out
         assert (expect in text) if expect else ("polymorph" not in text)
-    for extra, args in (("[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n",
-                         []),):
-        cfg.write_text(tiny_toml() + POLY + extra)
-        assert main(["stability", str(cfg), "--no-progress"] + args) == 2
-        err = capsys.readouterr().err
-        assert "polymorph.enabled" in err and err.count("\n") == 1
+    cfg.write_text(tiny_toml() + POLY + KINDS["two flagella on a free cell"][1])
+    assert main(["stability", str(cfg), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "polymorph.enabled" in err and "[[flagellum]]" in err and err.count("\n") == 1
 
 
 def test_tube_is_coloured_by_polymorph():
@@ -587,37 +584,48 @@ def test_turning_frame_and_lab_frame_agree_with_the_order_block():
 
 
 
-def _tiny_stability_cfg(extra=""):
-    return _cfg("[body]\nenabled = true\n" + POLY + extra)
+# the kinds of system linear stability takes with the order block: the rig with a held cell,
+# and a free-swimming no-slip cell (the swimmer's turning frame)
+STABILITY_BODIES = {"held cell": "[body]\nenabled = true\n",
+                    "free cell": "[body]\nsurface = 'no-slip'\nmotion = 'free'\n"
+                                 "blob_spacing = 0.025\n"}
 
 
-def test_one_state_filament_has_the_fixed_rods_threshold():
+def _tiny_stability_cfg(extra="", body="held cell"):
+    return _cfg(STABILITY_BODIES[body] + POLY + extra)
+
+
+@pytest.mark.parametrize("body", list(STABILITY_BODIES))
+def test_one_state_filament_has_the_fixed_rods_threshold(body):
     """Linear stability with the order block: a one-state filament's order modes decouple
-    (no rest shape to move), so its M_c is the fixed rod's, bisection bracket for bracket; a
-    two-state (normal -> semicoiled) filament has another (measured 1351.8 vs 1323.8)."""
+    (no rest shape to move), so its M_c is the fixed rod's, bisection bracket for bracket, on
+    the rig and on a free cell; a two-state (normal -> semicoiled) filament has another
+    (measured 1351.8 vs 1323.8 held, 1373.4 vs 1318.1 free)."""
     from flagwrap.stability.threshold import critical_from_config
 
-    plain = critical_from_config(_cfg("[body]\nenabled = true\n"), "cw", m_start=400.0)
-    one = critical_from_config(_tiny_stability_cfg("polymorph_b = 'ecoli_normal'\n"), "cw",
-                               m_start=400.0)
-    two = critical_from_config(_tiny_stability_cfg(), "cw", m_start=400.0)
+    plain = critical_from_config(_cfg(STABILITY_BODIES[body]), "cw", m_start=400.0)
+    one = critical_from_config(_tiny_stability_cfg("polymorph_b = 'ecoli_normal'\n", body),
+                               "cw", m_start=400.0)
+    two = critical_from_config(_tiny_stability_cfg(body=body), "cw", m_start=400.0)
     # the same bisection steps; M_c interpolated inside the bracket from eigenvalues whose
-    # finite-difference noise is ~1e-10 (measured 4e-10 apart)
+    # finite-difference noise is ~1e-10 (measured 4e-10 and 6e-10 apart)
     assert one.bracket == plain.bracket
     assert one.machin_c == pytest.approx(plain.machin_c, rel=1e-8)
     assert one.crossing == plain.crossing
     assert abs(two.machin_c / plain.machin_c - 1.0) > 0.005
 
 
-def test_polymorph_frame_jacobian_is_the_derivative_of_its_velocity():
+@pytest.mark.parametrize("body", list(STABILITY_BODIES))
+def test_polymorph_frame_jacobian_is_the_derivative_of_its_velocity(body):
     """``PolymorphFrame.jacobian`` (the rod's block plus the order's cross blocks) against
     central differences of ``velocity`` over every unknown, at a steady whirl of the
-    two-state filament: each block to 1e-7 of its largest entry (measured 2e-10; central
-    differences with step 1e-6 carry ~1e-10 relative error)."""
+    two-state filament on the rig and on a free cell (the swimmer's dense mobility in the
+    cross block): each block to 1e-7 of its largest entry (measured 1.5e-10 to 3e-10;
+    central differences with step 1e-6 carry ~1e-10 relative error)."""
     from flagwrap.stability.steady import start_state
     from flagwrap.stability.threshold import make_frame
 
-    fr = make_frame(_tiny_stability_cfg(), -1.0)
+    fr = make_frame(_tiny_stability_cfg(body=body), -1.0)
     st = start_state(fr, 1000.0)
     assert st.converged
     J = fr.jacobian(st.z, st.base, st.machin, st.info)
@@ -637,7 +645,8 @@ def test_polymorph_frame_jacobian_is_the_derivative_of_its_velocity():
         assert np.abs(J[r, c] - Jfd[r, c]).max() < 1e-7 * scale
 
 
-def test_stability_starts_from_the_relaxed_order():
+@pytest.mark.parametrize("body", list(STABILITY_BODIES))
+def test_stability_starts_from_the_relaxed_order(body):
     """With tilted wells (``maxwell_torque``) the configured state is not at rest: the frame's
     ``initial_state`` relaxes it first. At rest the rod is stress-free for any uniform phi,
     so phi is the tilted well's root, ``W (phi^3 - phi) = h`` with ``h = -N_M Delta / 2``
@@ -647,7 +656,7 @@ def test_stability_starts_from_the_relaxed_order():
     from flagwrap.stability.steady import newton
     from flagwrap.stability.threshold import make_frame
 
-    fr = make_frame(_tiny_stability_cfg("maxwell_torque = 1e-5\n"), -1.0)
+    fr = make_frame(_tiny_stability_cfg("maxwell_torque = 1e-5\n", body), -1.0)
     z, base = fr.initial_state()
     m = fr.system.model
     h = m.tilt(0.0)

@@ -249,14 +249,12 @@ def resolve_m_max(config, m_start: float, m_max: float | None) -> float:
 
 def refuse_polymorph(config) -> None:
     """A one-line :class:`UserInputError` for a polymorphic filament linear stability does
-    not take yet: on a free cell or with several flagella (docs/polymorph.md)."""
-    if config.polymorph.enabled and (config.body.free or len(config.flagella) > 1):
-        what = "body.motion = 'free'" if config.body.free else "several [[flagellum]] tables"
+    not take: several flagella (the turning frame needs one on the motor axis)."""
+    if config.polymorph.enabled and len(config.flagella) > 1:
         raise UserInputError(
-            f"polymorph.enabled = true with {what} is not available to flagwrap stability yet "
-            "(one polymorphic filament on the rig or a held cell); run it in the time domain "
-            "(flagwrap run), or set polymorph.enabled = false for the fixed shape of "
-            "polymorph_a")
+            "polymorph.enabled = true with several [[flagellum]] tables is not available to "
+            "flagwrap stability (its turning frame needs one flagellum on the motor axis); "
+            "run it in the time domain (flagwrap run)")
 
 
 def refuse_tube(config) -> None:
@@ -273,8 +271,8 @@ def make_frame(config, omega: float):
     """The turning frame of ``config``'s system at ``omega``: a free swimmer's
     (:class:`~flagwrap.system.swimmer.SwimmerFrame`) or the rig's
     (:class:`~flagwrap.system.rotating.RotatingFrame`; a fixed no-slip body's blob shell held
-    at one angle, ``blob_body``). A polymorphic filament is refused by name: its order
-    parameters are not unknowns of the turning frame yet (docs/polymorph.md)."""
+    at one angle, ``blob_body``); for a polymorphic filament either with its order
+    parameters among the unknowns (:class:`~flagwrap.system.polymorph.PolymorphFrame`)."""
     refuse_polymorph(config)
     refuse_tube(config)
     if config.body.free:
@@ -284,6 +282,10 @@ def make_frame(config, omega: float):
                 "against the wall); run it in the time domain (flagwrap run)")
         from flagwrap.system.swimmer import SwimmerFrame, make_swimmer
 
+        if config.polymorph.enabled:
+            from flagwrap.system.polymorph import PolymorphFrame, PolymorphSystem
+
+            return PolymorphFrame(PolymorphSystem(make_swimmer(config)), omega)
         return SwimmerFrame(make_swimmer(config), omega)
     from flagwrap.system.rod_system import RodSystem
     from flagwrap.system.rotating import RotatingFrame

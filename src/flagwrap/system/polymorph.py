@@ -462,47 +462,63 @@ PolymorphRotating = _rotating_class()
 
 
 class PolymorphFrame:
-    """A polymorphic rig (:class:`PolymorphSystem` over the lab-frame ``RodSystem``) in the
-    frame turning with its motor at ``omega``, for linear stability (:mod:`flagwrap.stability`):
-    the interface of :class:`~flagwrap.system.rotating.RotatingFrame`, with the order
-    parameters among the unknowns.
+    """A polymorphic filament (:class:`PolymorphSystem` over the lab-frame ``RodSystem`` or
+    a free :class:`~flagwrap.system.swimmer.SwimmerSystem`) in the frame turning with its
+    motor at ``omega``, for linear stability (:mod:`flagwrap.stability`): the interface of
+    :class:`~flagwrap.system.rotating.RotatingFrame`, with the order parameters among the
+    unknowns.
 
-    ``z = [x', theta', order]``: the lab state without the motor angle (which sits between
-    the rod's unknowns and the order block), in the turning frame. The order parameters get
-    no rotation term (scalars carried by the material). Their kinetics scales with the Machin
-    number as the mobilities do: ``Gamma`` fixed in SI, so its core value goes as ``1/M``
-    along a continuation in ``M`` (the steady states do not depend on ``Gamma``, only the
-    order's eigenvalues do).
+    ``z = [z_rod, order]``: ``z_rod`` the unknowns of the system's own turning frame (the
+    rig's :class:`~flagwrap.system.rotating.RotatingFrame`: the lab state without the motor
+    angle; a free swimmer's :class:`~flagwrap.system.swimmer.SwimmerFrame`: the filament's
+    in body axes, the pose not an unknown), then the order block. The order parameters get
+    no rotation term (scalars carried by the material), and they load no part of the fluid
+    (their forces move ``phi`` only), so the swimmer's body motion does not see them
+    directly. Their kinetics scales with the Machin number as the mobilities do: ``Gamma``
+    fixed in SI, so its core value goes as ``1/M`` along a continuation in ``M`` (the steady
+    states do not depend on ``Gamma``, only the order's eigenvalues do).
 
     The Jacobian is exact, cross terms included, as linear stability needs (the time
-    stepper's ``W`` leaves them out). The rod's block is the rig's own turning-frame Jacobian
-    at the order parameters held fixed (:meth:`RotatingFrame.jacobian` of the system's rod
-    view). The other blocks are central differences of the generalized forces over the order
-    columns and of the order's forces over the rod's columns, times the mobilities, which do
-    not depend on ``phi``.
+    stepper's ``W`` leaves them out). The rod's block is the system's own turning-frame
+    Jacobian at the order parameters held fixed (its frame's ``jacobian`` on the system's
+    rod view). The other blocks are central differences of the generalized forces over the
+    order columns (times the rod frame's mobility, :meth:`RotatingFrame.mobility_product`)
+    and of the order's forces over the rod's columns (times the block's mobility); no
+    mobility depends on ``phi``.
     """
 
     def __init__(self, system, omega: float, blob_body: bool = False):
         from flagwrap.system.rotating import RotatingFrame
+        from flagwrap.system.swimmer import SwimmerFrame, SwimmerSystem
 
-        if not isinstance(system, PolymorphSystem) or type(system._rod) is not RodSystem:
-            raise ValueError("PolymorphFrame: a PolymorphSystem over the lab-frame RodSystem")
+        rod = getattr(system, "_rod", None)
+        if not isinstance(system, PolymorphSystem) or type(rod) not in (RodSystem,
+                                                                        SwimmerSystem):
+            raise ValueError("PolymorphFrame: a PolymorphSystem over the lab-frame RodSystem "
+                             "or a SwimmerSystem")
         self.system = system
-        self.rod_frame = RotatingFrame(system._rod, omega, blob_body=blob_body)
+        self.rod_frame = (SwimmerFrame(rod, omega) if isinstance(rod, SwimmerSystem)
+                          else RotatingFrame(rod, omega, blob_body=blob_body))
         self.omega = self.rod_frame.omega
         self.axis = self.rod_frame.axis
-        self.i_phi = system.i_phi
-        self.n_rod = system.n_rod - 1  # the rod's unknowns in z
-        self.n = system.ny - 1
+        self.n_rod = self.rod_frame.n  # the rod's unknowns in z
+        self.n = self.n_rod + (system.sl_order.stop - system.sl_order.start)
         self.n3 = 3 * system.nb
 
     def full(self, z) -> np.ndarray:
-        """The lab state vector at ``phi = 0`` (where both frames coincide)."""
-        return np.insert(np.asarray(z, float), self.i_phi, 0.0)
+        """The state vector of the rod frame's :meth:`full` (``phi = 0``, where the frames
+        coincide; a swimmer's pose at the origin) with the order block appended."""
+        s, nr = self.system, self.n_rod
+        z = np.asarray(z, float)
+        y = np.empty(s.ny)
+        y[:s.n_inner] = self.rod_frame.full(z[:nr])
+        y[s.sl_order] = z[nr:]
+        return y
 
     def reduce(self, y) -> np.ndarray:
-        """The unknowns ``z`` of a state ``y``: :meth:`full`'s inverse."""
-        return np.delete(np.asarray(y, float), self.i_phi)
+        """The unknowns ``z`` of a state ``y`` (a copy): :meth:`full`'s inverse."""
+        y = np.asarray(y, float)
+        return np.concatenate([y[:self.n_rod], y[self.system.sl_order]])
 
     def initial_state(self, t_max: float = 5000.0, tol: float = 1e-9):
         """``(z, base)``: the filament at rest with its order parameters relaxed, the start of
@@ -549,9 +565,9 @@ class PolymorphFrame:
         nr, n = self.n_rod, self.n
         so = s.sl_order
         h = s.fd_step
-        # dG/dz by central differences over every unknown but the motor angle (the rod's
-        # unknowns come before it, the order block after): the cross blocks are read from it
-        cols = np.delete(np.arange(s.ny), self.i_phi)
+        # dG/dz by central differences over every unknown of z (the rod's come first, the
+        # order block last): the cross blocks are read from it
+        cols = np.concatenate([np.arange(nr), np.arange(so.start, so.stop)])
         dG = np.empty((s.ny, n))
         yp = y.copy()
         for j, k in enumerate(cols):
@@ -566,10 +582,7 @@ class PolymorphFrame:
         J = np.empty((n, n))
         J[:nr, :nr] = self.rod_frame.jacobian(z[:nr], base, machin, info)
         c = self.scale(machin)
-        Mxx, mt = s.mobility_blocks(y)
-        n3 = self.n3
-        J[:n3, nr:] = c * (Mxx @ dG_do[:n3])
-        J[n3:nr, nr:] = c * (mt[:, None] * dG_do[n3:nr])
+        J[:nr, nr:] = c * self.rod_frame.mobility_product(y[:s.n_inner], dG_do[:nr])
         m = c * s.order_mobility[:, None]
         J[nr:, :nr] = m * dGo_dr
         J[nr:, nr:] = m * dG_do[so]

@@ -194,16 +194,23 @@ class RotatingFrame:
                 J[r, k:k + 3] += om * g
         return J
 
+    def mobility_product(self, y, X) -> np.ndarray:
+        """``Mob X`` (n, k): the mobility over the unknowns ``z`` at the system's Machin number
+        (the beads' block and the twists' local drag) times ``X`` (n, k), the forces' change
+        along k directions."""
+        s, n, n3 = self.system, self.n, self.n3
+        Mxx, mt = s.mobility_blocks(y)
+        out = np.empty((n, X.shape[1]))
+        out[:n3] = Mxx @ X[:n3]
+        out[n3:] = mt[:, None] * X[n3:n]
+        return out
 
     def _mobility_jacobian(self, y, info, JG) -> np.ndarray:
         """``Mob (dG/dz) + (dMob/dx)[G]`` (n, n) at the system's Machin number; ``JG``: the
         force Jacobian over ``z``. ``(dMob/dx)[G]``: the mobility at fixed forces,
         differenced bead by bead."""
-        s, n, n3 = self.system, self.n, self.n3
-        Mxx, mt = s.mobility_blocks(y)
-        J = np.empty((n, n))
-        J[:n3] = Mxx @ JG[:n3]
-        J[n3:] = mt[:, None] * JG[n3:n]
+        s, n3 = self.system, self.n3
+        J = self.mobility_product(y, JG)
         if s.mobility.long_range:
             xf = np.ascontiguousarray(info.x[s.nc:])
             F = np.ascontiguousarray(info.G[:n3].reshape(-1, 3))

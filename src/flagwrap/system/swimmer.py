@@ -436,11 +436,17 @@ class SwimmerFrame(RotatingFrame):
         subtract_rotation(f, s, info, self.omega, self.axis, self._A)
         return f[:self.n], info
 
+    def mobility_product(self, y, X) -> np.ndarray:
+        """``A X``: the swimmer's dense mobility over ``z`` (:meth:`SwimmerSystem.
+        mobility_matrix`, the body's motion included) times ``X`` (n, k)."""
+        n = self.n
+        return self.system.mobility_matrix(y)[:n, :n] @ X[:n]
+
     def _mobility_jacobian(self, y, info, JG) -> np.ndarray:
         """``A (dG/dz) + (dA/dx)[G]``: ``A`` dense (:meth:`SwimmerSystem.mobility_matrix`),
         its change with the bead positions by central differences at fixed forces."""
         s, n, n3 = self.system, self.n, self.n3
-        J = s.mobility_matrix(y)[:n, :n] @ JG
+        J = self.mobility_product(y, JG)
         h = 1e-4 * s.bond  # as RotatingFrame: the mobility varies on the bead radius
         yp = y.copy()
         for k in range(n3):
