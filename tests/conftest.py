@@ -58,6 +58,7 @@ def system_kinds(polar_deg=30) -> dict:
         "krylov": ("linear_solver = 'krylov'\n", ""),
         "fixed no-slip body": ("", NO_SLIP_BODY),
         "free cell": ("", free),
+        "free cell, turning frame": ("frame = 'rotating'\n", free),
         "two flagella on a free cell": ("", free + "".join(
             f"[[flagellum]]\npolar_deg = {polar_deg}\nazimuth_deg = {az}\n" for az in (0, 180))),
     }

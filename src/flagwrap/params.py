@@ -1275,9 +1275,10 @@ class Config:
                     f"numerics.linear_solver = {self.numerics.linear_solver!r} cannot take a "
                     f"motor.kind = {self.motor.kind!r} motor (its row couples the whole W): use "
                     "'auto' or 'dense'")
-            if self.numerics.frame != "lab":
+            if self.numerics.frame != "lab" and not self.body.free:
                 raise UserInputError(f"numerics.frame = 'rotating' needs motor.kind = 'speed' "
-                                     f"(a {self.motor.kind} motor's rate is not known ahead)")
+                                     f"(a {self.motor.kind} motor's rate is not known ahead) "
+                                     "except on a free cell (body.motion = 'free')")
         # beads that are not contour neighbours must not overlap in the stress-free helix
         from flagwrap.geometry.helix import min_nonlocal_distance
 
@@ -1368,9 +1369,10 @@ class Config:
                 + (" or body.solver = 'krylov'" if direct else ""))
         check_spacing(blobs * self.filament.length, b.resolved_blob_radius(R),
                       what="body.blob_radius [m]")
-        if self.numerics.frame != "lab":
+        if self.numerics.frame != "lab" and not b.free:
             raise UserInputError("numerics.frame = 'rotating' needs a body symmetric about the "
-                                 "motor axis; a blob surface is not: use numerics.frame = 'lab'")
+                                 "motor axis; a held blob surface is not: use numerics.frame = "
+                                 "'lab'")
         if b.free:
             if all(p.direction == "stop" for p in self.motor.protocol):
                 raise UserInputError("body.motion = 'free' needs a motor that turns: every phase "

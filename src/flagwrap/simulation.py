@@ -521,6 +521,10 @@ def make_system(config):
         from flagwrap.system.swimmer import make_swimmer
 
         system = make_swimmer(config)
+        if config.numerics.frame == "rotating":
+            from flagwrap.system.swimmer import SwimmerRotating
+
+            system = SwimmerRotating(system)
     elif config.numerics.frame == "rotating":
         from flagwrap.system.rotating import RotatingSystem
 

@@ -148,8 +148,12 @@ class PolymorphSystem(RodSystem):
         from flagwrap.system.rotating import RotatingSystem
         from flagwrap.system.swimmer import SwimmerSystem
 
+        from flagwrap.system.swimmer import SwimmerRotating
+
         if cls is PolymorphSystem:
-            if isinstance(system, SwimmerSystem):
+            if isinstance(system, SwimmerRotating):
+                cls = PolymorphSwimmerRotating
+            elif isinstance(system, SwimmerSystem):
                 cls = PolymorphSwimmer
             elif isinstance(system, RotatingSystem):
                 cls = PolymorphRotating
@@ -444,6 +448,26 @@ def _swimmer_class():
 
 
 PolymorphSwimmer = _swimmer_class()
+
+
+def _swimmer_rotating_class():
+    from flagwrap.system.swimmer import SwimmerRotating
+
+    class PolymorphSwimmerRotating(PolymorphSystem, SwimmerRotating):
+        """A free swimmer in its motor's frame (:class:`~flagwrap.system.swimmer.
+        SwimmerRotating`) with the order block: ``y = [filament | pose | order]``, the
+        block as on :class:`PolymorphSwimmer` (its caches read through the stage solver's
+        view). The order parameters are scalars carried by the material: the frame adds no
+        term to their rate."""
+
+        _geometry = PolymorphSwimmer._geometry
+        _body = PolymorphSwimmer._body
+        mobility_matrix = PolymorphSwimmer.mobility_matrix
+
+    return PolymorphSwimmerRotating
+
+
+PolymorphSwimmerRotating = _swimmer_rotating_class()
 
 
 def _rotating_class():

@@ -46,6 +46,8 @@ velocities (:meth:`body_record`).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.linalg as sla
 
@@ -477,3 +479,165 @@ def make_swimmer(config):
                          wall_contact=contact)
 
 
+
+
+class SwimmerRotating(SwimmerSystem):
+    """The free swimmer stepped in the frame turning with its motor relative to the body
+    (``numerics.frame = "rotating"`` with ``body.motion = "free"``): the filament's
+    positions ``x''`` are the body-frame ones turned back by the motor angle ``phi`` about
+    the motor axis, ``x' = R(phi) x''``. A cell swimming steadily is then nearly a fixed
+    point of the filament's unknowns, as the rig's whirl is of
+    :class:`~flagwrap.system.rotating.RotatingSystem`, so the step follows the slow dynamics.
+
+    The body's blobs are not symmetric about the axis, so they are not held still in this
+    frame: each mobility product is the body frame's (:class:`SwimmerSystem`) at the turned
+    positions, by the rotation covariance of the mobility, ``A''(x'') = R^T A'(R x'') R``
+    (``R`` on each bead's block; twists are scalars). That is exact: the blob shell turns at
+    ``-dphi/dt`` under the filament. The forces are evaluated with the clamp at ``phi = 0``
+    (the energy is invariant under a rotation of everything), and the velocity gains the
+    frame's terms ``-w a x x''`` and ``-w a . t`` (twist), ``w = dphi/dt`` the motor's rate
+    relative to the body (a torque motor's too). The pose is the body's, as in
+    :class:`SwimmerSystem`.
+
+    The stage solver's ``W`` is the body frame's at ``phi = 0``: the blob shell held at one
+    angle (its ripple left to the W-method, whose order holds for any ``W``), so the lagged
+    screening follows the filament in this frame and is rebuilt only when it has moved
+    here. Run files are written in the lab frame (:meth:`record_view`, :meth:`body_record`).
+    """
+
+    def __init__(self, swimmer):
+        from flagwrap.system.rotating import check_rotating_frame
+
+        if type(swimmer) is not SwimmerSystem:
+            raise ValueError("SwimmerRotating: a SwimmerSystem")
+        check_rotating_frame(swimmer, blob_body=True)
+        if swimmer.wall is not None:
+            raise ValueError("SwimmerRotating: a free cell beside a wall (the wall moves "
+                             "in the body's frame)")
+        self.__dict__.update(swimmer.__dict__)  # the same parts and buffers: a view
+        self.axis = np.asarray(swimmer.joint.axis, float)
+        self._A = cross_matrix(self.axis)
+
+    # the frame ------------------------------------------------------------------------------
+    def _turn(self, y) -> np.ndarray:
+        """``R(phi)`` (3, 3), motor frame -> body frame."""
+        from flagwrap.system.rotating import rotation
+
+        return rotation(self.axis, float(y[self.i_phi]))
+
+    def _at_zero(self, y) -> np.ndarray:
+        y0 = np.array(y, float)
+        y0[self.i_phi] = 0.0
+        return y0
+
+    def _to_body(self, y, G, R):
+        """``(y', G')``: the state and generalized forces turned into the body frame (the
+        free beads' positions and forces by ``R``; twists, motor angle and pose as they
+        are)."""
+        sx = self.sl_x
+        yb = np.array(y, float)
+        yb[sx] = (y[sx].reshape(-1, 3) @ R.T).ravel()
+        Gb = np.array(G, float)
+        Gb[sx] = (G[sx].reshape(-1, 3) @ R.T).ravel()
+        return yb, Gb
+
+    # state ---------------------------------------------------------------------------------
+    def pack(self, x, theta, phi, X=(0.0, 0.0, 0.0), q=(1.0, 0.0, 0.0, 0.0)) -> np.ndarray:
+        """``y`` of this frame from body-frame beads ``x`` at motor angle ``phi``."""
+        from flagwrap.system.rotating import rotation
+
+        x_frame = np.asarray(x, float) @ rotation(self.axis, float(phi))  # R^T x, row-wise
+        return SwimmerSystem.pack(self, x_frame, theta, phi, X, q)
+
+    def unpack(self, y):
+        x, theta, _ = SwimmerSystem.unpack(self, self._at_zero(y))
+        return x, theta, float(y[self.i_phi])
+
+    def from_body_frame(self, y, base):
+        """``(y'', base'')``: a state ``y`` of the body-frame :class:`SwimmerSystem` of the
+        same config (with its reference frames ``base``) in this frame. Positions and
+        reference frames turn back by ``R(phi)``; the clamp's material frame is at ``phi = 0``
+        here, so every reference frame also turns by ``phi`` about its own tangent and every
+        twist angle loses ``phi`` (``R^T m1`` kept for each bond's material vector ``m1``)."""
+        from flagwrap.elasticity.rod import Frames
+
+        x, theta, phi = SwimmerSystem.unpack(self, y)
+        yr = self.pack(x, theta - phi, phi, y[self.sl_X], y[self.sl_q])
+        R = self._turn(yr)
+        t, d = base.t, base.d1
+        # Rodrigues about each tangent (d is perpendicular to t)
+        d1 = math.cos(phi) * d + math.sin(phi) * np.cross(t, d)
+        return yr, Frames(t @ R, d1 @ R, base.rt)
+
+    # forces: at the clamp's reference angle -----------------------------------------------
+    def forces(self, y, base):
+        return SwimmerSystem.forces(self, self._at_zero(y), base)
+
+    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
+        """The body frame's at ``phi = 0`` without the motor-angle column: here no force
+        depends on the motor angle."""
+        r, c, v = SwimmerSystem.force_jacobian_coo(self, self._at_zero(y), base, G0, delta,
+                                                   nonlocal_terms)
+        keep = c != self.i_phi
+        return r[keep], c[keep], v[keep]
+
+    def interaction_jacobian_coo(self, y, which: str = "all"):
+        return SwimmerSystem.interaction_jacobian_coo(self, self._at_zero(y), which)
+
+    def motor_torque(self, info, phi: float, omega: float, y=None) -> float:
+        return SwimmerSystem.motor_torque(self, info, 0.0, omega)
+
+    def motor_rate(self, y, info, omega: float):
+        return SwimmerSystem.motor_rate(self, self._at_zero(y), info, omega)
+
+    def motor_jacobian(self, y, base, omega: float):
+        rows = SwimmerSystem.motor_jacobian(self, self._at_zero(y), base, omega)
+        if rows is not None:
+            rows[:, self.i_phi] = 0.0  # no force depends on the motor angle here
+        return rows
+
+    # mobility ------------------------------------------------------------------------------
+    def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
+        """``R^T A'(R x'') R G``: the body frame's product at the turned positions, its bead
+        rows turned back; the pose rows are the body's own."""
+        R = self._turn(y)
+        yb, Gb = self._to_body(y, G, R)
+        out = SwimmerSystem.apply_mobility(self, yb, Gb, single)
+        sx = self.sl_x
+        out[sx] = (out[sx].reshape(-1, 3) @ R).ravel()
+        return out
+
+    def velocity(self, y, info, omega: float) -> np.ndarray:
+        from flagwrap.system.rotating import subtract_rotation
+
+        f = self.apply_mobility(y, info.G)
+        w = self.motor_rate(y, info, omega)
+        subtract_rotation(f, self, info, w, self.axis, self._A)
+        f[self.sl_phi] = w
+        return f
+
+    def body_velocity(self, y, G):
+        """The body frame's :meth:`SwimmerSystem.body_velocity` at the turned state: ``V``
+        in body axes, the beads' velocities turned into this frame, the blob forces."""
+        R = self._turn(y)
+        yb, Gb = self._to_body(y, G, R)
+        V, v, lam = SwimmerSystem.body_velocity(self, yb, Gb)
+        return V, v @ R, lam
+
+    def mobility_matrix(self, y, screening=True, reuse: bool = False) -> np.ndarray:
+        """The body frame's ``A`` at ``phi = 0``: the shell held at one angle. The stage
+        solver's (class docstring); not the exact mobility of this frame at other angles."""
+        return SwimmerSystem.mobility_matrix(self, self._at_zero(y), screening, reuse)
+
+    # output --------------------------------------------------------------------------------
+    def record_view(self, y, info):
+        """``info`` turned by the motor angle into the body frame, then into the lab."""
+        import dataclasses
+
+        from flagwrap.elasticity.rod import Frames
+
+        R = self._turn(y)
+        fr = info.frames
+        body = dataclasses.replace(info, x=info.x @ R.T, grad_x=info.grad_x @ R.T,
+                                   frames=Frames(fr.t @ R.T, fr.d1 @ R.T, fr.rt))
+        return SwimmerSystem.record_view(self, y, body)
