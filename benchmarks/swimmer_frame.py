@@ -3,14 +3,15 @@ swimming at equal accuracy (issue "A wrapping bacterium in minutes", item 1).
 
 Run: ``python benchmarks/swimmer_frame.py [--tol 1e-5] [--ref-tol 1e-8]``
 
-The cell of ``examples/s_putrefaciens.toml`` with its motor held at the reference speed (50
-Hz, so a motor turn is one reference turn), on one core (BLAS limited to one thread):
+The cell of ``examples/s_putrefaciens.toml`` with its torque-speed motor (``--motor case``,
+the default) or a speed motor at its reference 50 Hz (``--motor speed``), on one core (BLAS
+limited to one thread):
 
 1. a steady state: 2 turns from rest in the lab frame at tol 1e-7;
-2. from it, one more turn in each frame at ``--tol`` (the default frame's, 1e-5) and at
+2. from it, one more reference turn (20 ms) in each frame at ``--tol`` (the default frame's, 1e-5) and at
    ``--ref-tol`` (the reference), after a 0.01-turn run of each has loaded the kernels.
 
-Prints each run's steps, rejected steps and seconds, the ratios lab / turning frame, and each
+Prints each run's steps, rejected steps and seconds (also per motor turn), the ratios lab / turning frame, and each
 tol run's error against both references (the two frames' tight runs, which must agree with
 each other well below the errors they measure): the body's position and the free end's
 position at the turn's end [L], and the mean swimming speed over the turn (the body's
@@ -32,10 +33,15 @@ from flagwrap.params import Motor, Phase
 from flagwrap.simulation import Simulation, make_system
 
 
+MOTOR = "case"
+
+
 def config(turns: float, frame: str, tol: float):
     sp = load_config("examples/s_putrefaciens.toml")
-    return sp.replace(motor=Motor(frequency=sp.motor.frequency, protocol=(Phase("ccw", turns),)),
-                      numerics=dataclasses.replace(sp.numerics, frame=frame, tol=tol))
+    motor = (dataclasses.replace(sp.motor, protocol=(Phase("ccw", turns),)) if MOTOR == "case"
+             else Motor(frequency=sp.motor.frequency, protocol=(Phase("ccw", turns),)))
+    return sp.replace(motor=motor, numerics=dataclasses.replace(sp.numerics, frame=frame,
+                                                                 tol=tol))
 
 
 def in_frame(system, lab_system, y, base):
@@ -65,7 +71,11 @@ def main(argv=None):
     p = argparse.ArgumentParser()
     p.add_argument("--tol", type=float, default=1e-5)
     p.add_argument("--ref-tol", type=float, default=1e-8)
+    p.add_argument("--motor", choices=("case", "speed"), default="case",
+                   help="the example's torque-speed motor, or a speed motor at its 50 Hz")
     args = p.parse_args(argv)
+    global MOTOR
+    MOTOR = args.motor
     with threadpool_limits(limits=1):
         for frame in ("lab", "rotating"):  # load the kernels
             Simulation(config(0.01, frame, 1e-3)).run()
@@ -78,8 +88,11 @@ def main(argv=None):
             for frame in ("lab", "rotating"):
                 runs[frame, tol] = one_turn(frame, tol, y0, base0, lab_system, t0)
                 r, dt = runs[frame, tol]
+                turns = abs(r.phi[-1] - r.phi[0]) / (2 * math.pi)
                 print(f"{frame:<9s} tol {tol:g}: {r.status} steps {r.n_steps:6d} rejected "
-                      f"{r.n_rejected:5d} {dt:8.2f} s", flush=True)
+                      f"{r.n_rejected:5d} {dt:8.2f} s over {turns:.2f} motor turns: "
+                      f"{r.n_steps / turns:.0f} steps, {dt / turns:.2f} s per motor turn",
+                      flush=True)
     (lab, tl), (rot, tr_) = runs["lab", args.tol], runs["rotating", args.tol]
     print(f"lab / turning frame at tol {args.tol:g}: steps {lab.n_steps / rot.n_steps:.1f}x, "
           f"time {tl / tr_:.1f}x")

@@ -116,3 +116,32 @@ def test_what_the_turning_frame_cannot_treat_is_refused_by_name(tmp_path, capsys
     err = capsys.readouterr().err
     assert key in err and "numerics.frame = 'lab'" in err and err.count("\n") == 1
     assert not out.exists()
+
+
+def test_stage_solver_carries_the_frames_turn_at_the_motors_load(rng):
+    """With a torque motor the frame turns at the motor's rate ``w(y)``, so each rate's
+    frame term ``-w c`` (``c = a x x''``, ``a . t``) moves with the load: ``W^T`` gains
+    ``gamma h (dw/dy) c^T``. Checked against ``c`` from the velocity's own frame term
+    (:func:`~flagwrap.system.rotating.subtract_rotation`) and ``dw/dy`` by central
+    differences of the motor's rate, to 1e-7 (the differences' error)."""
+    from flagwrap.system.rotating import subtract_rotation
+
+    _, _, _, s, y, info = _state(rng, TORQUE_SPEED)
+    n, i, gh, h = s.n_in, s.i_phi, 0.3, 1e-6
+    dw = np.empty(n)
+    for k in range(n):
+        yp, ym = y.copy(), y.copy()
+        yp[k] += h
+        ym[k] -= h
+        dw[k] = (s.motor_rate(yp, s.forces(yp, info.frames), 1.0)
+                 - s.motor_rate(ym, s.forces(ym, info.frames), 1.0)) / (2 * h)
+    assert abs(dw[i]) < 1e-9 * np.abs(dw).max()  # no force depends on the motor angle here
+    minus_c = np.zeros(s.ny)
+    subtract_rotation(minus_c, s, info, 1.0, s.axis, s._A)
+    WT = np.eye(n)
+    WT[:, i] -= gh * dw
+    before = WT.copy()
+    s.frame_rows(WT, y[:n])
+    expect = gh * np.outer(dw, -minus_c[:i])
+    assert np.abs((WT - before)[:, :i] - expect).max() < 1e-7 * np.abs(expect).max()
+    assert np.array_equal(WT[:, i:], before[:, i:])

@@ -329,6 +329,10 @@ class SwimmerSystem(RodSystem):
             self._body_rows = ND / s.machin
         return A
 
+    def frame_rows(self, WT, y) -> None:
+        """What a moving frame adds to ``W^T`` (written in place) once the torque motor's row
+        is in ``WT``: nothing in the body frame."""
+
     def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
         """The stage solver (:class:`SwimmerW`); every ``kind`` gets it."""
         return SwimmerW(self, y, base, G0, gamma_h, omega)
@@ -389,6 +393,7 @@ class SwimmerW:
         w_transpose_dense(rows, cols, vals, A, _NO_TWIST_BLOCK, gamma_h, WT)  # Mob = A whole
         if system.drive.free:  # a torque motor's row, as the rig's DenseW
             add_motor_rows(WT, system, y[:n], base, gamma_h, omega)
+            system.frame_rows(WT, y[:n])
         self.n = n
         self.lu = lu_of_transpose(WT)
         q = y[system.sl_q] / np.linalg.norm(y[system.sl_q])
@@ -595,6 +600,22 @@ class SwimmerRotating(SwimmerSystem):
         if rows is not None:
             rows[:, self.i_phi] = 0.0  # no force depends on the motor angle here
         return rows
+
+    def frame_rows(self, WT, y) -> None:
+        """A torque motor's rate ``w(y)`` turns this frame, so every bead's and bond's rate
+        (``-w a x x''``, ``-w a . t``) follows the motor's load: ``W`` gains ``gamma h c
+        (dw/dy)``, ``c`` those directions, rank one. ``dw/dy`` is read off the motor's column
+        of ``WT`` (``-gamma h dw/dy`` there, :func:`~flagwrap.integrators.linear.
+        add_motor_rows`)."""
+        i = self.i_phi
+        col = np.array(WT[:, i])
+        col[i] -= 1.0
+        x, _, _ = self.unpack(y)
+        c = np.empty(i)
+        c[self.sl_x] = np.cross(self.axis, x[self.nc:]).ravel()
+        e = x[self.ec + 1:] - x[self.ec:-1]
+        c[self.sl_th] = (e @ self.axis) / np.linalg.norm(e, axis=1)
+        WT[:, :i] -= np.outer(col, c)
 
     # mobility ------------------------------------------------------------------------------
     def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
