@@ -224,12 +224,14 @@ def test_a_checkpoint_from_before_the_solver_memory_is_named_as_such(checkpoint)
 
 
 
-def test_resume_is_bit_identical_for_a_free_swimmer(tmp_path):
+@pytest.mark.parametrize("frame", ["lab", "rotating"])
+def test_resume_is_bit_identical_for_a_free_swimmer(tmp_path, frame):
     """A free cell's checkpoint holds its pose (in y) and the body records: the resumed run
-    equals the uninterrupted one, body pose and velocities included."""
+    equals the uninterrupted one, body pose and velocities included, in the body's frame and
+    in the motor's."""
+    text = tiny_toml(ccw=0.05, cw=0.05).replace("[numerics]\n", f"[numerics]\nframe = '{frame}'\n")
     cfg = config_from_dict(tomllib.loads(
-        tiny_toml(ccw=0.05, cw=0.05) + "\n[body]\nsurface = 'no-slip'\nmotion = 'free'\n"
-        "blob_spacing = 0.025\n"))
+        text + "\n[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n"))
     assert "body" in _assert_resume_identical(cfg, tmp_path)
 
 

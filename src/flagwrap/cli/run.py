@@ -47,7 +47,8 @@ def add_arguments(p):
     p.add_argument("--integrator", choices=["ros34pw2", "ros2", "euler"], help="override numerics.integrator")
     p.add_argument("--frame", choices=["lab", "rotating"], default=None,
                    help="step in the lab frame or the frame turning with the motor (numerics.frame; "
-                        "docs/stability.md); the run file is in the lab frame either way")
+                        "docs/stability.md; on a free cell the motor's frame relative to the body, "
+                        "docs/bacterium.md); the run file is in the lab frame either way")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--perturb", type=float, default=None, metavar="METRES",
                    help="start from the rest shape displaced by at most this much (overrides "
