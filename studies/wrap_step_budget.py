@@ -3,12 +3,14 @@ a run, accepted or rejected, with the unknown that set its error and that bead's
 the body.
 
     python studies/wrap_step_budget.py [CASE] [--turns CCW CW] [--bin 0.5] [--contact 2.0]
+                                       [--frame lab|rotating]
 
 ``CASE`` (default ``s_putrefaciens_wrap``) runs as ``flagwrap run`` would, with the local
 error's max-norm (``DofLayout.scaled_error``) decomposed at each attempt: the unknown with the
 largest ``|err_i| / w_i`` and its block (``x``: a bead's position, ``theta``: a twist angle,
 ``body_x``/``body_q``: the pose, ...). For a bead, its centre's distance to the body's surface
-in units of the filament radius ``a`` (body frame for a free cell): "at the body" when below
+in units of the filament radius ``a`` (body frame for a free cell; in the motor's frame
+(``--frame rotating``) the same, the body being axisymmetric): "at the body" when below
 ``--contact`` a (the contact law's range is ``a (1 + range)``), "near the body" below 10 a,
 "at the filament" when another bead of the chain (not one of its three neighbours each side)
 is within twice ``--contact`` a (self-contact), "free" otherwise.
@@ -33,6 +35,8 @@ def main(argv=None) -> int:
     ap.add_argument("--turns", type=float, nargs=2, default=None, metavar=("CCW", "CW"))
     ap.add_argument("--bin", type=float, default=0.5)
     ap.add_argument("--contact", type=float, default=2.0)
+    ap.add_argument("--frame", choices=("lab", "rotating"), default=None,
+                    help="numerics.frame (default: the case's)")
     args = ap.parse_args(argv)
 
     import dataclasses
@@ -49,6 +53,8 @@ def main(argv=None) -> int:
     if args.turns is not None:
         cfg = cfg.replace(motor=dataclasses.replace(cfg.motor, protocol=(
             Phase("ccw", args.turns[0]), Phase("cw", args.turns[1]))))
+    if args.frame is not None:
+        cfg = cfg.replace(numerics=dataclasses.replace(cfg.numerics, frame=args.frame))
     system = make_system(cfg)
     shape = config_shape(cfg)  # core units (lengths in L), the body's frame
     a = cfg.filament.cross_section_radius / cfg.filament.length
