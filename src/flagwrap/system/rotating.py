@@ -234,7 +234,35 @@ def rotation(axis, angle: float) -> np.ndarray:
     return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
 
 
-class RotatingSystem(RodSystem):
+class AtReferenceAngle:
+    """What a frame turning with the motor shares, whatever system it turns (a mixin before
+    the system's class: :class:`RotatingSystem`, :class:`~flagwrap.system.swimmer.
+    SwimmerRotating`): the forces, their Jacobians and the motor's torque are the system's
+    own with the clamp at its reference angle ``phi = 0``, and no force depends on the motor
+    angle, so its Jacobian column is dropped."""
+
+    def _at_zero(self, y) -> np.ndarray:
+        y0 = np.array(y, float)
+        y0[self.i_phi] = 0.0
+        return y0
+
+    def forces(self, y, base):
+        return super().forces(self._at_zero(y), base)
+
+    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
+        r, c, v = super().force_jacobian_coo(self._at_zero(y), base, G0, delta, nonlocal_terms)
+        keep = c != self.i_phi
+        return r[keep], c[keep], v[keep]
+
+    def interaction_jacobian_coo(self, y, which: str = "all"):
+        return super().interaction_jacobian_coo(self._at_zero(y), which)
+
+    def motor_torque(self, info, phi: float, omega: float, y=None) -> float:
+        """The system's own, from forces evaluated here with the clamp at ``phi = 0``."""
+        return super().motor_torque(info, 0.0, omega)
+
+
+class RotatingSystem(AtReferenceAngle, RodSystem):
     """A :class:`~flagwrap.system.rod_system.RodSystem` stepped in the frame turning with its
     motor (``numerics.frame = "rotating"``): the same system (its parts, layout, mobility and
     interactions, shared, not copied) under the equations of this frame.
@@ -257,11 +285,6 @@ class RotatingSystem(RodSystem):
         self.axis = np.asarray(system.joint.axis, float)
         self._A = cross_matrix(self.axis)
 
-    def _at_zero(self, y) -> np.ndarray:
-        y0 = np.array(y, float)
-        y0[self.i_phi] = 0.0
-        return y0
-
     def _lab_rotation(self, phi) -> np.ndarray:
         return rotation(self.axis, float(phi))
 
@@ -276,27 +299,11 @@ class RotatingSystem(RodSystem):
         x, theta, _ = RodSystem.unpack(self, self._at_zero(y))
         return x, theta, float(y[self.i_phi])
 
-    def forces(self, y, base):
-        return RodSystem.forces(self, self._at_zero(y), base)
-
     def velocity(self, y, info, omega: float) -> np.ndarray:
         f = self.apply_mobility(y, info.G)
         subtract_rotation(f, self, info, omega, self.axis, self._A)
         f[self.i_phi] = omega
         return f
-
-    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
-        r, c, v = RodSystem.force_jacobian_coo(self, self._at_zero(y), base, G0, delta,
-                                               nonlocal_terms)
-        keep = c != self.i_phi
-        return r[keep], c[keep], v[keep]
-
-    def interaction_jacobian_coo(self, y, which: str = "all"):
-        return RodSystem.interaction_jacobian_coo(self, self._at_zero(y), which)
-
-    def motor_torque(self, info, phi: float, omega: float, y=None) -> float:
-        """The lab system's, from forces evaluated here with the clamp at ``phi = 0``."""
-        return RodSystem.motor_torque(self, info, 0.0, omega)
 
     def record_view(self, y, info):
         """``info`` with its positions, gradients and reference frames turned by the motor

@@ -57,8 +57,8 @@ from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.hydrodynamics.polydisperse import rpy_cross_block
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.rod_system import RodSystem
-from flagwrap.system.rotating import (RotatingFrame, check_rotating_frame, cross_matrix,
-                                      subtract_rotation)
+from flagwrap.system.rotating import (AtReferenceAngle, RotatingFrame, check_rotating_frame,
+                                      cross_matrix, subtract_rotation)
 
 
 def quaternion_rate_matrix(q) -> np.ndarray:
@@ -486,7 +486,7 @@ def make_swimmer(config):
 
 
 
-class SwimmerRotating(SwimmerSystem):
+class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
     """The free swimmer stepped in the frame turning with its motor relative to the body
     (``numerics.frame = "rotating"`` with ``body.motion = "free"``): the filament's
     positions ``x''`` are the body-frame ones turned back by the motor angle ``phi`` about
@@ -530,11 +530,6 @@ class SwimmerRotating(SwimmerSystem):
 
         return rotation(self.axis, float(y[self.i_phi]))
 
-    def _at_zero(self, y) -> np.ndarray:
-        y0 = np.array(y, float)
-        y0[self.i_phi] = 0.0
-        return y0
-
     def _to_body(self, y, G, R):
         """``(y', G')``: the state and generalized forces turned into the body frame (the
         free beads' positions and forces by ``R``; twists, motor angle and pose as they
@@ -574,24 +569,7 @@ class SwimmerRotating(SwimmerSystem):
         d1 = math.cos(phi) * d + math.sin(phi) * np.cross(t, d)
         return yr, Frames(t @ R, d1 @ R, base.rt)
 
-    # forces: at the clamp's reference angle -----------------------------------------------
-    def forces(self, y, base):
-        return SwimmerSystem.forces(self, self._at_zero(y), base)
-
-    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
-        """The body frame's at ``phi = 0`` without the motor-angle column: here no force
-        depends on the motor angle."""
-        r, c, v = SwimmerSystem.force_jacobian_coo(self, self._at_zero(y), base, G0, delta,
-                                                   nonlocal_terms)
-        keep = c != self.i_phi
-        return r[keep], c[keep], v[keep]
-
-    def interaction_jacobian_coo(self, y, which: str = "all"):
-        return SwimmerSystem.interaction_jacobian_coo(self, self._at_zero(y), which)
-
-    def motor_torque(self, info, phi: float, omega: float, y=None) -> float:
-        return SwimmerSystem.motor_torque(self, info, 0.0, omega)
-
+    # forces at the clamp's reference angle (AtReferenceAngle) ---------------------------
     def motor_rate(self, y, info, omega: float):
         return SwimmerSystem.motor_rate(self, self._at_zero(y), info, omega)
 
