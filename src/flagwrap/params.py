@@ -1374,6 +1374,11 @@ class Config:
                                  "motor axis; a held blob surface is not: use numerics.frame = "
                                  "'lab'")
         if b.free:
+            if self.numerics.linear_solver not in ("auto", "dense", "krylov"):
+                raise UserInputError(
+                    f"numerics.linear_solver = {self.numerics.linear_solver!r} with body.motion = "
+                    "'free': a free cell's stage solver is 'dense' (the default, 'auto') or "
+                    "'krylov'")
             if all(p.direction == "stop" for p in self.motor.protocol):
                 raise UserInputError("body.motion = 'free' needs a motor that turns: every phase "
                                      "of motor.protocol is 'stop'")

@@ -145,3 +145,72 @@ def test_stage_solver_carries_the_frames_turn_at_the_motors_load(rng):
     expect = gh * np.outer(dw, -minus_c[:i])
     assert np.abs((WT - before)[:, :i] - expect).max() < 1e-7 * np.abs(expect).max()
     assert np.array_equal(WT[:, i:], before[:, i:])
+
+
+# --- the matrix-free stage solver (SwimmerKrylovW) on every kind of free cell ---------------
+
+FREE_KINDS = ("free cell", "free cell, turning frame", "two flagella on a free cell")
+
+
+def _kind_cfg(kind, solver, tol=1e-7, **kw):
+    from conftest import system_kinds
+
+    num, tables = system_kinds()[kind]
+    text = tiny_toml(**kw).replace("[numerics]\n", f"[numerics]\n{num}linear_solver = "
+                                   f"'{solver}'\n").replace("tol = 1e-3", f"tol = {tol}")
+    return config_from_dict(tomllib.loads(text + tables))
+
+
+@pytest.mark.parametrize("kind", FREE_KINDS)
+def test_krylov_stage_solver_runs_as_the_dense_one(kind):
+    """``numerics.linear_solver = "krylov"`` on a free cell: a W-method with another W, so
+    the run takes about the dense one's steps (within 5 %) and lands within both runs' own
+    error of it at tol 1e-7 (measured 4.5e-7, 2.2e-6 and 8.0e-7 L apart; 1e-5 allows 4x)."""
+    from flagwrap.system.swimmer import SwimmerKrylovW
+
+    a, b = [simulate(_kind_cfg(kind, solver, ccw=0.2, cw=0.1)) for solver in ("dense", "krylov")]
+    assert a.status == b.status == "completed"
+    assert abs(b.n_steps / a.n_steps - 1.0) < 0.05
+    assert np.abs(np.asarray(a.x[-1]) - np.asarray(b.x[-1])).max() < 1e-5
+    assert np.abs(np.asarray(a.body[-1])[:7] - np.asarray(b.body[-1])[:7]).max() < 1e-5
+    s = make_system(_kind_cfg(kind, "krylov"))
+    y = s.initial_y()
+    info = s.forces(y, s.frames0)
+    assert isinstance(s.make_w("krylov", y, info.frames, info.G, 0.01), SwimmerKrylovW)
+
+
+@pytest.mark.parametrize("kind", FREE_KINDS)
+def test_krylov_solve_meets_its_residual_and_the_dense_pose_rows(kind, rng):
+    """One solve at a loaded state: the filaments' rows leave a relative residual of ``W``
+    (its own matrix-free product) below the 1e-3 it stops at, and the pose rows are the
+    dense solver's ``gamma h P J u`` for that ``u`` (:class:`SwimmerW`, built from the
+    body's rows, an independent route) to 1e-10."""
+    from flagwrap.system.swimmer import SwimmerW
+
+    s = make_system(_kind_cfg(kind, "krylov"))
+    y = s.initial_y()
+    y[s.sl_x] += 0.01 * s.bond * rng.standard_normal(s.sl_x.stop - s.sl_x.start)
+    info = s.forces(y, s.frames0)
+    gh = 0.05
+    W = s.make_w("krylov", y, info.frames, info.G, gh)
+    rhs = rng.standard_normal(s.ny)
+    n = s.n_in
+    rhs[s.i_phi] = 0.0
+    u = W.solve(rhs)
+    r = W.matvec(u[:n]) - rhs[:n]
+    assert np.linalg.norm(r) <= 1e-3 * np.linalg.norm(rhs[:n])
+    assert W.iterations > 0
+    dense = SwimmerW(s, y, info.frames, info.G, gh)
+    pose = rhs[n:] + dense.PJ @ u[:n]
+    assert np.abs(u[n:] - pose).max() < 1e-10 * max(1.0, np.abs(pose).max())
+
+
+def test_a_free_cell_refuses_a_stage_solver_it_has_not(tmp_path, capsys):
+    from flagwrap.cli.main import main
+
+    cfg = tmp_path / "c.toml"
+    text = tiny_toml().replace("[numerics]\n", "[numerics]\nlinear_solver = 'near'\n", 1)
+    cfg.write_text(text + NO_SLIP_BODY + "motion = 'free'\n")
+    assert main(["run", str(cfg), "-o", str(tmp_path / "r.nc"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "numerics.linear_solver" in err and "'krylov'" in err and err.count("\n") == 1

@@ -334,7 +334,10 @@ class SwimmerSystem(RodSystem):
         is in ``WT``: nothing in the body frame."""
 
     def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
-        """The stage solver (:class:`SwimmerW`); every ``kind`` gets it."""
+        """The stage solver: ``numerics.linear_solver = "krylov"`` matrix-free
+        (:class:`SwimmerKrylovW`), any other kind dense (:class:`SwimmerW`)."""
+        if kind == "krylov":
+            return SwimmerKrylovW(self, y, base, G0, gamma_h, err_scale)
         return SwimmerW(self, y, base, G0, gamma_h, omega)
 
     # output --------------------------------------------------------------------------------
@@ -484,6 +487,90 @@ def make_swimmer(config):
                          wall_contact=contact)
 
 
+
+
+class SwimmerKrylovW:
+    """The swimmer's ``W`` (:class:`SwimmerW`'s block lower triangular form) solved
+    matrix-free: the filaments' block by preconditioned GCR with recycling (the rig's
+    :class:`~flagwrap.integrators.linear.KrylovW`), each product ``v - gamma h A (J v)`` with
+    the swimmer's own mobility product (the body's blobs, its motion and every filament's
+    hydrodynamics, exact: :meth:`SwimmerSystem.apply_mobility`), then the pose rows forward
+    from one more product, ``gamma h P J u`` being that product's pose rates.
+
+    Preconditioner: each filament's own dense ``I - gamma h M_k J_kk``, ``M_k`` the
+    free-space RPY among its free beads and its twists' local drag (no body, no other
+    filament): ``n_f`` LUs of one filament's size instead of one of them all, so the cost per
+    step grows as the products do. The iterations carry what it leaves out (the body's
+    screening and motion, the filaments' mutual flow). Speed motors only (a torque motor's
+    row couples the whole ``W``: refused by ``numerics.linear_solver`` before any work).
+    """
+
+    def __init__(self, system, y, base, G0, gamma_h, err_scale=None):
+        import scipy.sparse as sp
+
+        from flagwrap.integrators.linear import KrylovW
+
+        n = system.n_in
+        self.system, self.y, self.gh, self.n = system, y, gamma_h, n
+        rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n])
+        self.J = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+        x, _, _ = system.unpack(y)
+        x_free = x[system.free_beads]
+        mt = np.broadcast_to(system.twist_mobility, (system.ne,))
+        self.blocks = []
+        for p in system.parts:
+            idx = np.arange(p.ny) if p.ymap is None else p.ymap
+            pos, tw = idx[:3 * p.nb], idx[3 * p.nb:3 * p.nb + p.ne]
+            I = np.concatenate([pos, tw])
+            xf = np.ascontiguousarray(x_free[pos[::3] // 3])
+            M = np.zeros((len(I), len(I)))
+            M[:len(pos), :len(pos)] = system.mobility.matrix(xf) / system.machin
+            k = np.arange(len(pos), len(I))
+            M[k, k] = mt[tw - system.sl_th.start]
+            W = np.eye(len(I)) - gamma_h * (M @ self.J[I][:, I].toarray())
+            self.blocks.append((I, sla.lu_factor(W, check_finite=False)))
+        self._gcr = KrylovW.__new__(KrylovW)
+        g = self._gcr
+        g.system, g.y, g.gh, g.rtol, g.maxiter, g.kappa = system, y, gamma_h, 1e-3, 200, 0.1
+        g.inv_scale = None if err_scale is None else 1.0 / np.asarray(err_scale, float)[:n]
+        g.P, g.J = _FilamentBlocks(self.blocks), self.J
+        g.Z, g.C = np.empty((KrylovW.max_vectors, n)), np.empty((KrylovW.max_vectors, n))
+        g.k, g.iterations = 0, 0
+        g.matvec = self.matvec
+
+    @property
+    def iterations(self) -> int:
+        return self._gcr.iterations
+
+    def _product(self, v):
+        """``A (J v)`` over the whole state (filaments and pose rows)."""
+        G = np.zeros(self.system.ny)
+        G[:self.n] = self.J @ v
+        return self.system.apply_mobility(self.y, G)
+
+    def matvec(self, v):
+        return v - self.gh * self._product(v)[:self.n]
+
+    def solve(self, rhs):
+        u = self._gcr.solve(np.asarray(rhs[:self.n], float))
+        out = np.array(rhs, float)
+        out[:self.n] = u
+        out[self.n:] += self.gh * self._product(u)[self.n:]
+        return out
+
+
+class _FilamentBlocks:
+    """:class:`SwimmerKrylovW`'s preconditioner: each filament's LU on its own unknowns, the
+    identity on the motor angles."""
+
+    def __init__(self, blocks):
+        self.blocks = blocks
+
+    def solve(self, r):
+        z = np.array(r, float)
+        for I, lu in self.blocks:
+            z[I] = sla.lu_solve(lu, r[I], check_finite=False)
+        return z
 
 
 class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
