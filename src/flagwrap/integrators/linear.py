@@ -144,10 +144,7 @@ class KrylovW:
         self.system = system
         self.y = y
         self.gh = gamma_h
-        self.rtol = rtol
-        self.maxiter = maxiter
-        self.inv_scale = None if err_scale is None else 1.0 / np.asarray(err_scale, float)
-        self.kappa = kappa
+        self._gcr_setup(system.ny, rtol, maxiter, err_scale, kappa)
         rows, cols, vals = system.force_jacobian_coo(y, base, G0, nonlocal_terms=False)
         self.P = BandedW(system, y, base, G0, gamma_h, width=width,
                          triplets=(rows, cols, vals))
@@ -156,7 +153,15 @@ class KrylovW:
             rows, cols, vals = (np.concatenate([rows, r]), np.concatenate([cols, c]),
                                 np.concatenate([vals, v]))
         self.J = sp.csr_matrix((vals, (rows, cols)), shape=(system.ny, system.ny))
-        n = system.ny
+
+    def _gcr_setup(self, n, rtol, maxiter, err_scale, kappa) -> None:
+        """The iteration's state for ``n`` unknowns: the stopping rule (class docstring) and
+        the recycled directions. A subclass sets ``P`` (the preconditioner, ``P.solve``) and
+        ``matvec``."""
+        self.rtol = rtol
+        self.maxiter = maxiter
+        self.inv_scale = None if err_scale is None else 1.0 / np.asarray(err_scale, float)
+        self.kappa = kappa
         self.Z = np.empty((self.max_vectors, n))
         self.C = np.empty((self.max_vectors, n))
         self.k = 0

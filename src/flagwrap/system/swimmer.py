@@ -55,6 +55,7 @@ from flagwrap.body.multiblob import geometric_matrix
 from flagwrap.body.solver import LaggedScreening
 from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.hydrodynamics.polydisperse import rpy_cross_block
+from flagwrap.integrators.linear import KAPPA, KrylovW
 from flagwrap.system.layout import DofLayout
 from flagwrap.system.rod_system import RodSystem
 from flagwrap.system.rotating import (AtReferenceAngle, RotatingFrame, check_rotating_frame,
@@ -487,15 +488,14 @@ def make_swimmer(config):
                          wall_contact=contact)
 
 
-
-
-class SwimmerKrylovW:
+class SwimmerKrylovW(KrylovW):
     """The swimmer's ``W`` (:class:`SwimmerW`'s block lower triangular form) solved
-    matrix-free: the filaments' block by preconditioned GCR with recycling (the rig's
-    :class:`~flagwrap.integrators.linear.KrylovW`), each product ``v - gamma h A (J v)`` with
-    the swimmer's own mobility product (the body's blobs, its motion and every filament's
-    hydrodynamics, exact: :meth:`SwimmerSystem.apply_mobility`), then the pose rows forward
-    from one more product, ``gamma h P J u`` being that product's pose rates.
+    matrix-free: the filaments' block by the rig's preconditioned GCR with recycling
+    (:class:`~flagwrap.integrators.linear.KrylovW`, whose loop and stopping rule this
+    inherits), each product ``v - gamma h A (J v)`` with the swimmer's own mobility product
+    (the body's blobs, its motion and every filament's hydrodynamics, exact:
+    :meth:`SwimmerSystem.apply_mobility`), then the pose rows forward from one more product,
+    ``gamma h P J u`` being that product's pose rates.
 
     Preconditioner: each filament's own dense ``I - gamma h M_k J_kk``, ``M_k`` the
     free-space RPY among its free beads and its twists' local drag (no body, no other
@@ -505,19 +505,19 @@ class SwimmerKrylovW:
     row couples the whole ``W``: refused by ``numerics.linear_solver`` before any work).
     """
 
-    def __init__(self, system, y, base, G0, gamma_h, err_scale=None):
+    def __init__(self, system, y, base, G0, gamma_h, err_scale=None, rtol=1e-3, maxiter=200,
+                 kappa=KAPPA):
         import scipy.sparse as sp
-
-        from flagwrap.integrators.linear import KrylovW
 
         n = system.n_in
         self.system, self.y, self.gh, self.n = system, y, gamma_h, n
+        self._gcr_setup(n, rtol, maxiter, None if err_scale is None else err_scale[:n], kappa)
         rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n])
         self.J = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
         x, _, _ = system.unpack(y)
         x_free = x[system.free_beads]
         mt = np.broadcast_to(system.twist_mobility, (system.ne,))
-        self.blocks = []
+        blocks = []
         for p in system.parts:
             idx = np.arange(p.ny) if p.ymap is None else p.ymap
             pos, tw = idx[:3 * p.nb], idx[3 * p.nb:3 * p.nb + p.ne]
@@ -528,19 +528,8 @@ class SwimmerKrylovW:
             k = np.arange(len(pos), len(I))
             M[k, k] = mt[tw - system.sl_th.start]
             W = np.eye(len(I)) - gamma_h * (M @ self.J[I][:, I].toarray())
-            self.blocks.append((I, sla.lu_factor(W, check_finite=False)))
-        self._gcr = KrylovW.__new__(KrylovW)
-        g = self._gcr
-        g.system, g.y, g.gh, g.rtol, g.maxiter, g.kappa = system, y, gamma_h, 1e-3, 200, 0.1
-        g.inv_scale = None if err_scale is None else 1.0 / np.asarray(err_scale, float)[:n]
-        g.P, g.J = _FilamentBlocks(self.blocks), self.J
-        g.Z, g.C = np.empty((KrylovW.max_vectors, n)), np.empty((KrylovW.max_vectors, n))
-        g.k, g.iterations = 0, 0
-        g.matvec = self.matvec
-
-    @property
-    def iterations(self) -> int:
-        return self._gcr.iterations
+            blocks.append((I, sla.lu_factor(W, check_finite=False)))
+        self.P = _FilamentBlocks(blocks)
 
     def _product(self, v):
         """``A (J v)`` over the whole state (filaments and pose rows)."""
@@ -552,7 +541,7 @@ class SwimmerKrylovW:
         return v - self.gh * self._product(v)[:self.n]
 
     def solve(self, rhs):
-        u = self._gcr.solve(np.asarray(rhs[:self.n], float))
+        u = super().solve(np.asarray(rhs[:self.n], float))
         out = np.array(rhs, float)
         out[:self.n] = u
         out[self.n:] += self.gh * self._product(u)[self.n:]
