@@ -214,3 +214,19 @@ def test_a_free_cell_refuses_a_stage_solver_it_has_not(tmp_path, capsys):
     assert main(["run", str(cfg), "-o", str(tmp_path / "r.nc"), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "numerics.linear_solver" in err and "'krylov'" in err and err.count("\n") == 1
+
+
+def test_auto_picks_the_matrix_free_solver_above_the_crossover(monkeypatch):
+    """``linear_solver = "auto"`` on a free cell: dense up to ``AUTO_KRYLOV_NY`` filament
+    unknowns, matrix-free above (speed motors); a torque motor keeps the dense one."""
+    import flagwrap.system.swimmer as sw
+
+    for motor in ("", TORQUE_SPEED):
+        s = make_system(_cfg("lab", motor))
+        y = s.initial_y()
+        info = s.forces(y, s.frames0)
+        assert isinstance(s.make_w("auto", y, info.frames, info.G, 0.01, omega=1.0), sw.SwimmerW)
+        monkeypatch.setattr(sw, "AUTO_KRYLOV_NY", s.n_in - 1)
+        picked = s.make_w("auto", y, info.frames, info.G, 0.01, omega=1.0)
+        assert isinstance(picked, sw.SwimmerW if motor else sw.SwimmerKrylovW)
+        monkeypatch.undo()

@@ -62,6 +62,13 @@ from flagwrap.system.rotating import (AtReferenceAngle, RotatingFrame, check_rot
                                       cross_matrix, subtract_rotation)
 
 
+#: ``numerics.linear_solver = "auto"`` on a free cell: the matrix-free stage solver above
+#: this many filament unknowns (speed motors). Measured per motor turn (benchmarks/bundle.py,
+#: docs/bundle.md): 3 flagella, 958 unknowns, dense 43.4 s and Krylov 41.5 s; 4 flagella, 1275,
+#: dense 167 s and Krylov 65 s: the crossover lies between.
+AUTO_KRYLOV_NY = 1100
+
+
 def quaternion_rate_matrix(q) -> np.ndarray:
     """``Q(q)`` (4, 3) with ``q (0, Omega) = Q(q) Omega``, so that :func:`quaternion_rate` is
     ``Q(q) Omega / 2``."""
@@ -335,9 +342,11 @@ class SwimmerSystem(RodSystem):
         is in ``WT``: nothing in the body frame."""
 
     def make_w(self, kind, y, base, G0, gamma_h, err_scale=None, omega=None):
-        """The stage solver: ``numerics.linear_solver = "krylov"`` matrix-free
-        (:class:`SwimmerKrylovW`), any other kind dense (:class:`SwimmerW`)."""
-        if kind == "krylov":
+        """The stage solver: matrix-free (:class:`SwimmerKrylovW`) for ``"krylov"``, and for
+        ``"auto"`` with speed motors above :data:`AUTO_KRYLOV_NY` filament unknowns; dense
+        (:class:`SwimmerW`) otherwise."""
+        if kind == "krylov" or (kind == "auto" and not self.drive.free
+                                and self.n_in > AUTO_KRYLOV_NY):
             return SwimmerKrylovW(self, y, base, G0, gamma_h, err_scale)
         return SwimmerW(self, y, base, G0, gamma_h, omega)
 
