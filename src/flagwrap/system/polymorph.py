@@ -146,9 +146,7 @@ class PolymorphSystem(RodSystem):
 
     def __new__(cls, system, *args, **kwargs):
         from flagwrap.system.rotating import RotatingSystem
-        from flagwrap.system.swimmer import SwimmerSystem
-
-        from flagwrap.system.swimmer import SwimmerRotating
+        from flagwrap.system.swimmer import SwimmerRotating, SwimmerSystem
 
         if cls is PolymorphSystem:
             if isinstance(system, SwimmerRotating):
