@@ -17,26 +17,10 @@ The free swimmer is not on this path: its stage solver is dense (docs/bundle.md,
 from __future__ import annotations
 
 import argparse
-import json
-import subprocess
-import sys
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from _child import EXAMPLE, run
 
 CHILD = r"""
-import dataclasses, json, resource, sys
-sys.path.insert(0, {studies!r})
-from bundle_vs_equivalent import case_config
-from flagwrap.io.config import load_config
-from flagwrap.params import Phase
-from flagwrap.simulation import Simulation, make_system
-
-def rss_kb():
-    for line in open("/proc/self/status"):
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1])
-
 n, spacing = {n}, {spacing}
 base = load_config({example!r})
 base = base.replace(motor=dataclasses.replace(base.motor, protocol=(Phase("ccw", 0.002),)),
@@ -68,15 +52,7 @@ def main(argv=None) -> int:
     rows = []
     for sp in args.spacing:
         for n in args.n:
-            code = CHILD.format(studies=str(ROOT / "studies"), n=n, spacing=sp,
-                                example=str(ROOT / "examples" / "p_putida_bundle.toml"))
-            out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                                 env={"OMP_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1",
-                                      "OPENBLAS_NUM_THREADS": "1", **_env()})
-            if out.returncode:
-                print(out.stderr.strip().splitlines()[-1], file=sys.stderr)
-                return 1
-            r = json.loads(out.stdout.strip().splitlines()[-1])
+            r = run(CHILD.format(n=n, spacing=sp, example=EXAMPLE))
             rows.append(r)
             print(f"n = {n}  beads {r['beads']:5d}  blobs {r['blobs']:5d}  steps {r['steps']}  "
                   f"peak above start {r['peak_mb']:7.1f} MB", flush=True)
@@ -87,12 +63,6 @@ def main(argv=None) -> int:
     print(f"fit: peak = {c[0]:.2f} MB + {c[1] * 1e3:.2f} kB/bead + {c[2] * 1e3:.2f} kB/blob; "
           f"largest residual {res:.1%} of the largest peak")
     return 0
-
-
-def _env():
-    import os
-
-    return {k: v for k, v in os.environ.items() if k not in ("OMP_NUM_THREADS",)}
 
 
 if __name__ == "__main__":

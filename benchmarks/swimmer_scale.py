@@ -15,27 +15,11 @@ and the peak resident memory above the warmed process's (``ru_maxrss`` less ``Vm
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import subprocess
-import sys
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from _child import EXAMPLE, run
 
 CHILD = r"""
-import dataclasses, json, resource, sys, time
-sys.path.insert(0, {studies!r})
-from bundle_vs_equivalent import case_config
-from flagwrap.io.config import load_config
-from flagwrap.params import Phase
-from flagwrap.simulation import Simulation, make_system
 import flagwrap.system.swimmer as sw
-
-def rss_kb():
-    for line in open("/proc/self/status"):
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1])
 
 made = []
 orig = sw.SwimmerKrylovW.__init__
@@ -79,21 +63,12 @@ def main(argv=None) -> int:
                    help="blob spacings [um]")
     p.add_argument("--steps", type=int, default=15)
     args = p.parse_args(argv)
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1",
-           "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
     print("| flagella | beads | blobs | beads + blobs | filament unknowns | build [s] | "
           "ms per step | GCR iterations per step | peak memory [MB] |")
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for sp in args.spacing:
         for n in args.n:
-            code = CHILD.format(studies=str(ROOT / "studies"), n=n, spacing=sp, steps=args.steps,
-                                example=str(ROOT / "examples" / "p_putida_bundle.toml"))
-            out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                                 env=env)
-            if out.returncode:
-                print(out.stderr.strip().splitlines()[-1], file=sys.stderr)
-                return 1
-            r = json.loads(out.stdout.strip().splitlines()[-1])
+            r = run(CHILD.format(n=n, spacing=sp, steps=args.steps, example=EXAMPLE))
             print(f"| {r['n']} | {r['beads']} | {r['blobs']} | {r['beads'] + r['blobs']} | "
                   f"{r['ny']} | {r['build_s']:.1f} | {r['ms_per_step']:.0f} | "
                   f"{r['iterations']:.1f} | {r['peak_mb']:.0f} |", flush=True)
