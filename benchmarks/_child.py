@@ -35,7 +35,7 @@ def run(code: str) -> dict:
     """``PRELUDE + code`` in a fresh process on one thread: its last stdout line as JSON; a
     failure raises ``SystemExit`` with the child's last stderr line."""
     out = subprocess.run([sys.executable, "-c", PRELUDE + code], capture_output=True,
-                         text=True, env={**os.environ, **ONE_THREAD})
+                         text=True, env={**os.environ, **ONE_THREAD}, check=False)
     if out.returncode:
         raise SystemExit(out.stderr.strip().splitlines()[-1])
     return json.loads(out.stdout.strip().splitlines()[-1])
