@@ -246,6 +246,35 @@ class AtReferenceAngle:
         y0[self.i_phi] = 0.0
         return y0
 
+    def _turn(self, y) -> np.ndarray:
+        """``R(phi)`` (3, 3) at ``y``'s motor angle: this frame -> the system's own."""
+        return rotation(self.axis, float(y[self.i_phi]))
+
+    def pack(self, x, theta, phi, *pose, **kw) -> np.ndarray:
+        """``y`` of this frame from the system's own beads ``x`` at motor angle ``phi`` (and
+        a free body's pose): the positions turned back by ``phi`` about the motor axis
+        (through the origin, where the frame's axis is: :func:`check_rotating_frame`)."""
+        x_frame = np.asarray(x, float) @ rotation(self.axis, float(phi))  # R^T x, row-wise
+        return super().pack(x_frame, theta, phi, *pose, **kw)
+
+    def unpack(self, y):
+        x, theta, _ = super().unpack(self._at_zero(y))
+        return x, theta, float(y[self.i_phi])
+
+    def record_view(self, y, info):
+        """``info`` with its positions, gradients and reference frames turned by the motor
+        angle into the system's own frame (twist angles and energies are frame-independent),
+        then as the system records it (the rig: the lab; a free cell: its pose)."""
+        import dataclasses
+
+        from flagwrap.elasticity.rod import Frames
+
+        R = self._turn(y)
+        fr = info.frames
+        turned = dataclasses.replace(info, x=info.x @ R.T, grad_x=info.grad_x @ R.T,
+                                     frames=Frames(fr.t @ R.T, fr.d1 @ R.T, fr.rt))
+        return super().record_view(y, turned)
+
     def forces(self, y, base):
         return super().forces(self._at_zero(y), base)
 
@@ -285,34 +314,8 @@ class RotatingSystem(AtReferenceAngle, RodSystem):
         self.axis = np.asarray(system.joint.axis, float)
         self._A = cross_matrix(self.axis)
 
-    def _lab_rotation(self, phi) -> np.ndarray:
-        return rotation(self.axis, float(phi))
-
-    def pack(self, x, theta, phi) -> np.ndarray:
-        """``y`` of this frame from lab-frame beads ``x`` at motor angle ``phi``: the
-        positions turned back by ``phi`` about the motor axis (through the origin, where the
-        frame's axis is: :func:`check_rotating_frame`)."""
-        x_frame = np.asarray(x, float) @ self._lab_rotation(phi)  # R^T x, row by row
-        return RodSystem.pack(self, x_frame, theta, phi)
-
-    def unpack(self, y):
-        x, theta, _ = RodSystem.unpack(self, self._at_zero(y))
-        return x, theta, float(y[self.i_phi])
-
     def velocity(self, y, info, omega: float) -> np.ndarray:
         f = self.apply_mobility(y, info.G)
         subtract_rotation(f, self, info, omega, self.axis, self._A)
         f[self.i_phi] = omega
         return f
-
-    def record_view(self, y, info):
-        """``info`` with its positions, gradients and reference frames turned by the motor
-        angle into the lab frame (twist angles and energies are frame-independent)."""
-        import dataclasses
-
-        from flagwrap.elasticity.rod import Frames
-
-        R = self._lab_rotation(y[self.i_phi])
-        fr = info.frames
-        return dataclasses.replace(info, x=info.x @ R.T, grad_x=info.grad_x @ R.T,
-                                   frames=Frames(fr.t @ R.T, fr.d1 @ R.T, fr.rt))

@@ -608,13 +608,7 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
         self.axis = np.asarray(swimmer.joint.axis, float)
         self._A = cross_matrix(self.axis)
 
-    # the frame ------------------------------------------------------------------------------
-    def _turn(self, y) -> np.ndarray:
-        """``R(phi)`` (3, 3), motor frame -> body frame."""
-        from flagwrap.system.rotating import rotation
-
-        return rotation(self.axis, float(y[self.i_phi]))
-
+    # the frame (_turn, pack, unpack, record_view: AtReferenceAngle) ------------------------
     def _to_body(self, y, G, R):
         """``(y', G')``: the state and generalized forces turned into the body frame (the
         free beads' positions and forces by ``R``; twists, motor angle and pose as they
@@ -625,18 +619,6 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
         Gb = np.array(G, float)
         Gb[sx] = (G[sx].reshape(-1, 3) @ R.T).ravel()
         return yb, Gb
-
-    # state ---------------------------------------------------------------------------------
-    def pack(self, x, theta, phi, X=(0.0, 0.0, 0.0), q=(1.0, 0.0, 0.0, 0.0)) -> np.ndarray:
-        """``y`` of this frame from body-frame beads ``x`` at motor angle ``phi``."""
-        from flagwrap.system.rotating import rotation
-
-        x_frame = np.asarray(x, float) @ rotation(self.axis, float(phi))  # R^T x, row-wise
-        return SwimmerSystem.pack(self, x_frame, theta, phi, X, q)
-
-    def unpack(self, y):
-        x, theta, _ = SwimmerSystem.unpack(self, self._at_zero(y))
-        return x, theta, float(y[self.i_phi])
 
     def from_body_frame(self, y, base):
         """``(y'', base'')``: a state ``y`` of the body-frame :class:`SwimmerSystem` of the
@@ -712,16 +694,3 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
         """The body frame's ``A`` at ``phi = 0``: the shell held at one angle. The stage
         solver's (class docstring); not the exact mobility of this frame at other angles."""
         return SwimmerSystem.mobility_matrix(self, self._at_zero(y), screening, reuse)
-
-    # output --------------------------------------------------------------------------------
-    def record_view(self, y, info):
-        """``info`` turned by the motor angle into the body frame, then into the lab."""
-        import dataclasses
-
-        from flagwrap.elasticity.rod import Frames
-
-        R = self._turn(y)
-        fr = info.frames
-        body = dataclasses.replace(info, x=info.x @ R.T, grad_x=info.grad_x @ R.T,
-                                   frames=Frames(fr.t @ R.T, fr.d1 @ R.T, fr.rt))
-        return SwimmerSystem.record_view(self, y, body)
