@@ -23,28 +23,49 @@ def _cfg(frame="lab", motor="", extra="", tol=1e-3, **kw):
     return config_from_dict(tomllib.loads(text + NO_SLIP_BODY + "motion = 'free'\n" + extra))
 
 
-def _state(rng, motor=""):
+#: a tube about the cell and a tilted wall beside it, each within the contact range of the
+#: filament once the body is shifted 0.018 L along x (:func:`_state`'s ``shift``)
+BOUNDARIES = {
+    "tube": "[[tube]]\nradius = 0.07\nlength = 0.7\ncenter = [0.0, 0.0, -0.1]\n"
+            "blob_spacing = 0.035\n",
+    "tilted wall": "[[wall]]\npoint = [0.0715, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.02]\n",
+}
+
+
+def _state(rng, motor="", extra="", shift=0.0):
     """A body-frame swimmer's loaded state (beads and twists perturbed, the motor turned
-    0.7 rad) and the same state in the turning frame."""
-    body, turning = make_system(_cfg("lab", motor)), make_system(_cfg("rotating", motor))
+    0.7 rad, the body shifted ``shift`` along x and turned 0.05 rad about z) and the same
+    state in the turning frame."""
+    body = make_system(_cfg("lab", motor, extra))
+    turning = make_system(_cfg("rotating", motor, extra))
     assert type(body) is SwimmerSystem and type(turning) is SwimmerRotating
     y = body.initial_y()
     y[body.sl_x] += 0.01 * body.bond * rng.standard_normal(body.sl_x.stop - body.sl_x.start)
     y[body.sl_th] += 0.1 * rng.standard_normal(body.sl_th.stop - body.sl_th.start)
     y[body.i_phi] = 0.7
+    y[body.sl_X] = [shift, 0.0, 0.0]
+    y[body.sl_q] = [np.cos(0.025), 0.0, 0.0, np.sin(0.025)]
     info = body.forces(y, body.frames0)
     yr, base = turning.from_body_frame(y, info.frames)
     return body, y, info, turning, yr, turning.forces(yr, base)
 
 
-@pytest.mark.parametrize("motor", ["", TORQUE_SPEED], ids=["speed motor", "torque-speed motor"])
-def test_velocity_is_the_body_frames_turned(rng, motor):
+@pytest.mark.parametrize("motor, boundary", [
+    ("", None), (TORQUE_SPEED, None), ("", "tube"), ("", "tilted wall"),
+    (TORQUE_SPEED, "tube")],
+    ids=["speed motor", "torque-speed motor", "tube", "tilted wall", "torque-speed in a tube"])
+def test_velocity_is_the_body_frames_turned(rng, motor, boundary):
     """At one physical state the turning frame's rates, turned back and with the frame's own
     rotation added, are the body frame's: beads, twists, motor rate and pose to 1e-9 of
     their scale (the rotation covariance of the blob mobility is exact, not the held shell
-    of linear stability); the energy is the same."""
-    body, y, info, s, yr, ir = _state(rng, motor)
+    of linear stability); the energy is the same. Beside a boundary the filament touches
+    it (its contact placed in each frame at the state's own pose)."""
+    extra = BOUNDARIES.get(boundary, "")
+    body, y, info, s, yr, ir = _state(rng, motor, extra, 0.018 if boundary else 0.0)
     assert ir.elastic_energy == pytest.approx(info.elastic_energy, rel=1e-12)
+    if boundary:
+        assert info.interaction_energy > 0
+        assert ir.interaction_energy == pytest.approx(info.interaction_energy, rel=1e-10)
     f = body.velocity(y, info, 1.0)
     g = s.velocity(yr, ir, 1.0)
     w = g[s.i_phi]
@@ -99,13 +120,12 @@ def test_runs_in_both_frames_converge_to_one_answer(motor):
 
 
 @pytest.mark.parametrize("extra, key", [
-    ("[[wall]]\npoint = [0.0, 0.0, -1.0]\nnormal = [0.0, 0.0, 1.0]\n", "[[wall]]"),
     ("".join(f"[[flagellum]]\npolar_deg = 30\nazimuth_deg = {az}\n" for az in (0, 180)),
      "[[flagellum]]"),
 ])
 def test_what_the_turning_frame_cannot_treat_is_refused_by_name(tmp_path, capsys, extra, key):
-    """A free cell beside a wall (it moves against it) or with flagella off the axis: one
-    line naming the key and the lab frame, exit 2, before any work."""
+    """A free cell with flagella off the axis: one line naming the key and the lab frame,
+    exit 2, before any work."""
     from flagwrap.cli.main import main
 
     cfg = tmp_path / "c.toml"

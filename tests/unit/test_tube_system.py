@@ -16,12 +16,18 @@ from flagwrap.io.config import config_from_dict, config_to_toml
 TUBE = ("[[tube]]\nradius = 0.07\nlength = 0.5\ncenter = [0.0, 0.0, -0.2]\n"
         "blob_spacing = 0.025\n")
 BODY = "[body]\nsurface = 'no-slip'\nblob_spacing = 0.025\n"
+FREE_TUBE = ("[[tube]]\nradius = 0.07\nlength = 0.7\ncenter = [0.0, 0.0, -0.1]\n"
+             "blob_spacing = 0.05\n")
 KINDS = {
     "lab": ("", ""),
     "krylov": ("linear_solver = 'krylov'\n", ""),
     "no hydrodynamics (contact only)": ("hydrodynamics = false\n", ""),
     "tube chain": ("", "", "hydrodynamic_model = 'tube'\n"),
     "fixed no-slip body": ("", BODY),
+    # a free cell's tube covers its body too (the body stands 0.3 m above the motor)
+    "free cell": ("", BODY + "motion = 'free'\n", None, FREE_TUBE),
+    "free cell, turning frame": ("frame = 'rotating'\n", BODY + "motion = 'free'\n", None,
+                                 FREE_TUBE),
 }
 
 
@@ -40,12 +46,20 @@ def test_every_kind_of_system_runs_in_a_tube(kind, tmp_path):
     from flagwrap.io.runfile import config_of, read_run, write_run
     from flagwrap.simulation import make_system, simulate
 
-    cfg = config_from_dict(tomllib.loads(_text(*KINDS[kind][:2], *KINDS[kind][2:],
-                                               ccw=0.2, cw=0.1)))
+    numerics, tables, *more = KINDS[kind]
+    fil = more[0] if more else None
+    tube = more[1] if len(more) > 1 else TUBE
+    cfg = config_from_dict(tomllib.loads(_text(numerics, tables, fil, tube, ccw=0.2, cw=0.1)))
     s = make_system(cfg)
     assert any(isinstance(it, TubeContact) for it in s.interactions)
     m = s.mobility.inner if isinstance(s.mobility, TubeMobility) else s.mobility
-    if cfg.numerics.hydrodynamics:
+    if cfg.body.free:  # the swimmer sees the tube from its body, the tube's blobs apart
+        from flagwrap.body.boundaries import TubeFromBody
+        from flagwrap.system.parts import tube_blobs
+
+        assert isinstance(s.boundary, TubeFromBody)
+        assert len(s.boundary.blobs) == len(tube_blobs(cfg)[0])
+    elif cfg.numerics.hydrodynamics:
         assert isinstance(m, FixedBodyMobility)
         n_body = 0
         if cfg.body.no_slip:
@@ -133,7 +147,8 @@ def test_config_round_trips():
 
 @pytest.mark.parametrize("numerics, tables, tube, key", [
     ("frame = 'rotating'\n", "", TUBE, "numerics.frame"),
-    ("", BODY + "motion = 'free'\n", TUBE, "body.motion"),
+    ("frame = 'rotating'\n", BODY, TUBE, "numerics.frame"),
+    ("", BODY + "motion = 'free'\nsolver = 'krylov'\n", TUBE, "body.solver"),
     ("", "", TUBE + TUBE, "one tube"),
     ("", "[[wall]]\npoint = [0.0, 0.0, -0.5]\nnormal = [0.0, 0.0, 1.0]\n", TUBE, r"\[\[wall\]\]"),
     ("", "", TUBE.replace("radius = 0.07", "radius = 0.04"), "the filament starts"),
@@ -262,3 +277,37 @@ def test_movies_and_snapshots_draw_the_tubes_silhouette(tmp_path):
     fig = snapshot_figure(ds, n=2)
     grey = [ln for ax in fig.axes for ln in ax.lines if ln.get_color() == "0.55"]
     assert len(grey) == 2 * 2 * 2  # two lines, two cameras, two panels
+
+
+def test_analyze_reports_a_free_cell_in_a_tube(tmp_path, capsys):
+    """The body centre's distance from the tube's axis, its tilt and its speeds along the
+    tube and away from its axis, computed here from the pose directly (the sphere's centre
+    is its pole plus its radius along the body axis); and the CLI prints them."""
+    from flagwrap.analysis.runfile_attrs import analyze_run_file
+    from flagwrap.cli.main import main
+    from flagwrap.io.runfile import read_run, write_run
+    from flagwrap.observables.swimming import quaternion_matrices
+    from flagwrap.simulation import simulate
+
+    sphere = ("[body]\nsurface = 'no-slip'\nshape = 'sphere'\nradius = 0.05\n"
+              "blob_spacing = 0.02\nmotion = 'free'\n")
+    tube = FREE_TUBE.replace("center = [0.0, 0.0, -0.1]", "center = [0.005, 0.0, -0.1]")
+    cfg = config_from_dict(tomllib.loads(_text("", sphere, None, tube, ccw=0.2, cw=0.1)))
+    path = write_run(simulate(cfg), tmp_path / "free.nc")
+    w = analyze_run_file(path, write=False)["wall"]
+    ds = read_run(path)
+    R = quaternion_matrices(ds["body_orientation"].values)
+    c = ds["body_position"].values + 0.05 * R[:, :, 2]
+    r = np.hypot(c[:, 0] - 0.005, c[:, 1])  # the tube's axis is z through (0.005, 0)
+    assert w["boundary"] == "tube"
+    assert w["body_axis_distance_final"] == pytest.approx(r[-1], rel=1e-9)
+    assert w["body_axis_distance_max"] == pytest.approx(r.max(), rel=1e-9)
+    assert w["body_tilt_final_deg"] == pytest.approx(
+        math.degrees(math.acos(abs(R[-1, 2, 2]))), abs=1e-9)
+    t = ds["time"].values
+    k = np.flatnonzero(t >= t[-1] - 2 * math.pi / cfg.scales.omega - 1e-12 * t[-1])
+    dt = t[k[-1]] - t[k[0]]
+    assert w["speed_along"] == pytest.approx((c[k[-1], 2] - c[k[0], 2]) / dt, rel=1e-9)
+    assert w["speed_radial"] == pytest.approx((r[k[-1]] - r[k[0]]) / dt, rel=1e-9)
+    assert main(["analyze", str(path), "--no-store"]) == 0
+    assert "um/s along it" in capsys.readouterr().out

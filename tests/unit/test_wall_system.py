@@ -30,6 +30,7 @@ KINDS = {
     "tube chain": ("", "", "hydrodynamic_model = 'tube'\n"),
     "fixed no-slip body": ("", BODY),
     "free cell": ("", BODY + "motion = 'free'\n"),
+    "free cell, turning frame": ("frame = 'rotating'\n", BODY + "motion = 'free'\n"),
 }
 
 
@@ -328,13 +329,14 @@ def test_the_walls_push_on_a_free_body_is_its_contact_energys_gradient():
     # the body's steric load: -dU/dX along the normal by differences of the energy as the
     # wall moves (U depends on X - p), and no push beyond the cut-off
     from flagwrap.body import _kernels as BK
+    from flagwrap.body.boundaries import WallFromBody
     from flagwrap.hydrodynamics.wall import PlaneWall
     from flagwrap.simulation import make_system
 
     s = make_system(config_from_dict(tomllib.loads(tiny_toml() + FREE_SPHERE + (
         "[[wall]]\npoint = [0.0, 0.0, 0.1]\nnormal = [0.0, 0.0, -1.0]\n"))))
     y = s.initial_y()
-    wc = s._wall_contact
+    wc = s._boundary_contact
     cutoff, strength, c2 = wc.cutoff, wc.strength, wc.c2
     top = float(np.max(s.blobs[:, 2] + s.blob_radii))
 
@@ -345,14 +347,15 @@ def test_the_walls_push_on_a_free_body_is_its_contact_energys_gradient():
         return e.sum()
 
     z = top + 0.5 * cutoff  # the wall within reach of the top blobs
-    s.wall = PlaneWall([0.0, 0.0, z], [0.0, 0.0, -1.0])
+    s.boundary = WallFromBody(PlaneWall([0.0, 0.0, z], [0.0, 0.0, -1.0]))
     s._body_cache = (None, None)
     load = s.wall_load(y)
     h = 1e-6 * cutoff
     dUdz = (energy(z + h) - energy(z - h)) / (2 * h)  # moving the wall up = the body down
     assert load[2] == pytest.approx(dUdz, rel=1e-5) and load[2] < 0  # pushed away (down)
     assert np.abs(load[[0, 1, 3, 4, 5]]).max() < 1e-9 * abs(load[2])  # symmetric sphere
-    s.wall = PlaneWall([0.0, 0.0, top + 2 * cutoff], [0.0, 0.0, -1.0])
+    s.boundary = WallFromBody(PlaneWall([0.0, 0.0, top + 2 * cutoff], [0.0, 0.0, -1.0]))
+    s._body_cache = (None, None)
     assert np.all(s.wall_load(y) == 0.0)
 
 

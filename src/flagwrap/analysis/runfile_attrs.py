@@ -206,7 +206,8 @@ def analyze_run_file(path, analysis: BucklingAnalysis | None = None, write: bool
 
     wall = wall_summary(ds, final_turns=a.final.final_turns)
     res["wall"] = None if wall is None else {k: v for k, v in wall.items()
-                                             if k not in ("gap_series", "body_height")}
+                                             if k not in ("gap_series", "body_height",
+                                                          "body_axis_distance")}
     from flagwrap.observables.polymorph import polymorph_summaries
 
     poly = polymorph_summaries(ds)  # one per flagellum

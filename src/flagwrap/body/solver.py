@@ -52,12 +52,15 @@ class DirectBlobSolver:
     kind = "direct"
     INVERSE_MAX = 2500
 
-    def __init__(self, blobs: np.ndarray, radii: np.ndarray, wall=None, invert: bool = True):
+    def __init__(self, blobs: np.ndarray, radii: np.ndarray, wall=None, invert: bool = True,
+                 extra: np.ndarray | None = None):
         from scipy.linalg import lapack
 
         Mbb = PolydisperseRPY(radii).matrix(blobs)
         if wall is not None:  # beside a plane wall (flagwrap.hydrodynamics.wall)
             Mbb += wall_correction_matrix(wall, blobs, radii)
+        if extra is not None:  # any other boundary's Delta (flagwrap.body.boundaries)
+            Mbb += extra
         L, info = lapack.dpotrf(Mbb, lower=1, overwrite_a=1)
         if info != 0:
             raise ValueError(f"the blob matrix is not positive definite (LAPACK info {info})")

@@ -175,6 +175,12 @@ def boundary_lines(w: dict) -> list[str]:
                    f"end (closest {w['body_height_min']:.3g} m), axis {w['body_tilt_final_deg']:+.1f} "
                    f"deg to its plane; last turns: {w['speed_parallel'] * 1e6:.4g} um/s along it, "
                    f"{w['speed_normal'] * 1e6:+.3g} um/s away from it")
+    if "body_axis_distance_final" in w:
+        out.append(f"tube: body centre {w['body_axis_distance_final']:.3g} m from its axis at "
+                   f"the end (farthest {w['body_axis_distance_max']:.3g} m), body axis "
+                   f"{w['body_tilt_final_deg']:.1f} deg to the tube's; last turns: "
+                   f"{w['speed_along'] * 1e6:+.4g} um/s along it, {w['speed_radial'] * 1e6:+.3g} "
+                   "um/s away from its axis")
     return out
 
 

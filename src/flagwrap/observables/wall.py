@@ -9,6 +9,9 @@ docs/confinement.md, "Observables"), from a run file's positions.
   of its axis to the wall's plane at the end, and over the last turns its speed parallel
   to the wall and towards it (the body centre's displacement over the window, as
   :func:`flagwrap.observables.swimming.phase_summary` measures the swimming speed).
+* A free cell in a tube: its body centre's distance from the tube's axis over the run, the
+  angle of its axis to the tube's at the end, and over the last turns its speed along the
+  tube and away from its axis.
 """
 
 from __future__ import annotations
@@ -27,7 +30,11 @@ def wall_summary(ds, final_turns: float = 1.0) -> dict | None:
     A free cell beside a wall adds ``body_height`` (time,) [m] (its centre above the wall),
     ``body_height_final``, ``body_height_min`` [m], ``body_tilt_final_deg`` (its axis to the
     wall's plane, + pointing away from the wall), and over the last ``final_turns`` reference
-    turns ``speed_parallel`` and ``speed_normal`` [m/s] (+ away from the wall)."""
+    turns ``speed_parallel`` and ``speed_normal`` [m/s] (+ away from the wall). A free cell in
+    a tube adds ``body_axis_distance`` (time,) [m], ``body_axis_distance_final``,
+    ``body_axis_distance_max`` [m], ``body_tilt_final_deg`` (its axis to the tube's), and
+    ``speed_along`` (+ along ``tube.axis``) and ``speed_radial`` (+ away from the axis)
+    [m/s] over the last turns."""
     from flagwrap.io.runfile import config_of
 
     cfg = config_of(ds)
@@ -50,8 +57,9 @@ def wall_summary(ds, final_turns: float = 1.0) -> dict | None:
     k = int(np.argmin(series))
     out.update(gap_min=float(series[k]), gap_min_turns=float(ds["turns"].values[k]),
                gap_final=float(series[-1]), gap_series=series)
-    if cfg.walls and "body_position" in ds.variables:
-        out.update(_free_body_beside_wall(ds, cfg, n, p, final_turns))
+    if "body_position" in ds.variables:
+        out.update(_free_body_beside_wall(ds, cfg, n, p, final_turns) if cfg.walls
+                   else _free_body_in_tube(ds, cfg, tube, final_turns))
     return out
 
 
@@ -63,19 +71,40 @@ def body_centre(config) -> np.ndarray:
     return cell_body_blobs(config)[0].mean(axis=0) * config.filament.length
 
 
-def _free_body_beside_wall(ds, cfg, n, p, final_turns: float) -> dict:
+def _centres_and_window(ds, cfg, final_turns: float):
+    """``(R, c, d, dt)``: body rotations and lab centres (time, 3) [m], and the centre's
+    displacement over the last ``final_turns`` reference turns and its duration [s]."""
     from flagwrap.observables.swimming import quaternion_matrices
 
     R = quaternion_matrices(ds["body_orientation"].values)
     c = ds["body_position"].values + R @ body_centre(cfg)  # (time, 3) lab centres
-    h = (c - p) @ n
     t = ds["time"].values
     T = 1.0 / cfg.scales.omega
     t1 = float(t[-1])
     k = np.flatnonzero(t >= max(float(t[0]), t1 - 2 * math.pi * final_turns * T) - 1e-12 * t1)
     i, j = k[0], k[-1]
-    d = c[j] - c[i]
-    dt = t[j] - t[i]
+    return R, c, c[j] - c[i], t[j] - t[i]
+
+
+def _free_body_in_tube(ds, cfg, tube, final_turns: float) -> dict:
+    """A free cell in a tube: its body centre's distance from the axis (time,) [m], at the
+    end and its largest, its axis' angle to the tube's at the end, and over the last turns
+    its speed along the tube (+ along ``tube.axis``) and away from the axis [m/s]."""
+    R, c, d, dt = _centres_and_window(ds, cfg, final_turns)
+    _, r = tube.cylindrical(c)
+    _, r0 = tube.cylindrical(c[-1] - d)  # the window's first centre
+    a = np.asarray(tube.axis)
+    cos = min(1.0, abs(float(R[-1][:, 2] @ a)))
+    return {"body_axis_distance": r, "body_axis_distance_final": float(r[-1]),
+            "body_axis_distance_max": float(r.max()),
+            "body_tilt_final_deg": math.degrees(math.acos(cos)),
+            "speed_along": float(d @ a) / dt if dt > 0 else math.nan,
+            "speed_radial": float(r[-1] - r0) / dt if dt > 0 else math.nan}
+
+
+def _free_body_beside_wall(ds, cfg, n, p, final_turns: float) -> dict:
+    R, c, d, dt = _centres_and_window(ds, cfg, final_turns)
+    h = (c - p) @ n
     normal = float(d @ n)
     axis = R[-1][:, 2]
     return {"body_height": h, "body_height_final": float(h[-1]),

@@ -419,10 +419,10 @@ def _start_distances(config, distance):
 
 def check_walls(config) -> None:
     """Refuse ``[[wall]]`` tables that cannot be run (one line naming the key, before any
-    work): more than one wall, a free-swimming body beside one with the Krylov blob solver or
-    in the turning frame, the turning frame beside a wall not square to the body axis (its
-    symmetry is broken), a filament that starts within its radius of the wall or behind it, a
-    body across it."""
+    work): more than one wall, a free-swimming body beside one with the Krylov blob solver,
+    the turning frame of a held body or the rig beside a wall not square to the body axis
+    (its symmetry is broken; a free cell's turning frame places the wall at every state), a
+    filament that starts within its radius of the wall or behind it, a body across it."""
     from flagwrap.errors import UserInputError
 
     walls = config.walls
@@ -430,18 +430,13 @@ def check_walls(config) -> None:
         raise UserInputError(f"{len(walls)} [[wall]] tables: one wall is supported (the "
                              "Rotne-Prager-Blake mobility is a single plane's)")
     w = walls[0]
-    if config.body.free:  # the swimmer rebuilds its blob matrix per pose (a direct solve)
-        if config.body.solver == "krylov":
-            raise UserInputError("[[wall]] beside a free body needs body.solver = 'direct' or "
-                                 "'auto' (the blob matrix is refactorised at every pose)")
-        if config.numerics.frame != "lab":
-            raise UserInputError(f"[[wall]] beside a free body: numerics.frame = "
-                                 f"{config.numerics.frame!r} has no steady state (the cell moves "
-                                 "against the wall); use numerics.frame = 'lab'")
+    if config.body.free and config.body.solver == "krylov":  # refactorised per pose: direct
+        raise UserInputError("[[wall]] beside a free body needs body.solver = 'direct' or "
+                             "'auto' (the blob matrix is refactorised at every pose)")
     from flagwrap.hydrodynamics.wall import config_wall
 
     plane = config_wall(config)  # core units
-    if config.numerics.frame != "lab" and not plane.square_to_z:
+    if config.numerics.frame != "lab" and not plane.square_to_z and not config.body.free:
         raise UserInputError(f"[[wall]] with numerics.frame = {config.numerics.frame!r}: a "
                              "wall tilted from the plane z = const breaks the turning frame's "
                              "symmetry; use numerics.frame = 'lab' (or wall.normal = [0, 0, +-1])")
@@ -483,9 +478,10 @@ def tube_blobs(config) -> tuple[np.ndarray, np.ndarray]:
 
 def check_tubes(config) -> None:
     """Refuse ``[[tube]]`` tables that cannot be run (one line naming the key, before any
-    work): more than one tube, a tube with a wall, a free body in a tube (not built: its
-    blobs move through the tube's), the turning frame (a blob tube is not symmetric about the
-    motor axis), blobs too sparse for the tube, a body as wide as the tube (a constriction
+    work): more than one tube, a tube with a wall, a free body in a tube with the Krylov blob
+    solver (its blob matrix is refactorised at every pose), the turning frame of the rig or a
+    held body (a blob tube is not symmetric about the motor axis; a free cell's turning frame
+    places the tube at every state), blobs too sparse for the tube, a body as wide as the tube (a constriction
     narrower than the body is allowed: whether the cell passes is the question), a filament or
     body that starts across the tube's wall."""
     from flagwrap.errors import UserInputError
@@ -495,10 +491,10 @@ def check_tubes(config) -> None:
     if config.walls:
         raise UserInputError("[[tube]] with [[wall]]: one boundary at a time is supported; "
                              "drop one")
-    if config.body.free:
-        raise UserInputError("[[tube]] around a free body (body.motion = 'free') is not built "
-                             "yet: hold the body (body.motion = 'fixed') or drop the tube")
-    if config.numerics.frame != "lab":
+    if config.body.free and config.body.solver == "krylov":
+        raise UserInputError("[[tube]] around a free body needs body.solver = 'direct' or "
+                             "'auto' (the body's blob matrix is refactorised at every pose)")
+    if config.numerics.frame != "lab" and not config.body.free:
         raise UserInputError(f"[[tube]] with numerics.frame = {config.numerics.frame!r}: a "
                              "tube of blobs is not symmetric about the motor axis; use "
                              "numerics.frame = 'lab'")
@@ -541,19 +537,22 @@ def _check_tube_blob_count(config, tube) -> None:
     L = config.filament.length
     h = config.tubes[0].resolved_blob_spacing
     n = tube.estimated_blobs(h / L, BLOB_RADIUS_RATIO * h / L)
-    if config.body.no_slip:
+    # a free body's tube is factorised on its own (flagwrap.body.boundaries), a held body's
+    # with the body's blobs
+    joint = config.body.no_slip and not config.body.free
+    if joint:
         from flagwrap.body.multiblob import cell_body_blobs
 
         n += len(cell_body_blobs(config)[0])
-    direct = config.body.solver == "direct"
+    direct = config.body.solver == "direct" or config.body.free
     most = MAX_BLOBS if direct else MAX_BLOBS_KRYLOV
     if n > most:
         raise UserInputError(
             f"tube[0].blob_spacing = {h:g} m puts ~{n} blobs on the tube"
-            + (" and the body" if config.body.no_slip else "")
+            + (" and the body" if joint else "")
             + f", more than the {'direct' if direct else 'Krylov'} blob solve takes ({most}); "
             f"use a spacing >= {h * math.sqrt(n / most):.3g} m"
-            + (" or body.solver = 'krylov'" if direct else ""))
+            + (" or body.solver = 'krylov'" if direct and not config.body.free else ""))
 
 
 def _min_segment_distance(x, z) -> float:

@@ -330,8 +330,8 @@ class PolymorphSystem(RodSystem):
         info.polymorph_energy = self.order_energy(phi)
         return info
 
-    def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
-        out = super().apply_mobility(y, G, single)
+    def apply_mobility(self, y, G, single: bool = False, **kw) -> np.ndarray:
+        out = super().apply_mobility(y, G, single, **kw)
         np.multiply(self.order_mobility, G[self.sl_order], out=out[self.sl_order])
         return out
 

@@ -57,11 +57,13 @@ def subtract_rotation(f, system, info, omega: float, axis, A) -> None:
     f[s.sl_th] -= omega * (info.frames.t[s.ec:] @ axis)
 
 
-def check_rotating_frame(system, blob_body: bool = False) -> None:
+def check_rotating_frame(system, blob_body: bool = False, placed=()) -> None:
     """Refuse a system whose equations are not autonomous in the turning frame (one line,
     naming the part that breaks the symmetry about the motor axis). ``blob_body``: accept a
     no-slip blob body as if it were symmetric (its blobs held at one angle in the turning
-    frame: the linear-stability approximation of :class:`RotatingFrame`)."""
+    frame: the linear-stability approximation of :class:`RotatingFrame`). ``placed``:
+    interactions the frame itself places at each state (a free cell's boundary contact:
+    :class:`~flagwrap.system.swimmer.SwimmerRotating`), exact at any angle."""
     parts = getattr(system, "parts", ())
     if len(parts) > 1:
         raise UserInputError(
@@ -96,7 +98,7 @@ def check_rotating_frame(system, blob_body: bool = False) -> None:
             f"the rotating frame needs a mobility symmetric about the motor axis; "
             f"{type(system.mobility).__name__} (a no-slip blob body) is not: use the lab frame")
     for it in system.interactions:
-        if not getattr(it, "rotation_invariant", False):
+        if not getattr(it, "rotation_invariant", False) and not any(it is p for p in placed):
             raise UserInputError(
                 f"the rotating frame needs every interaction to be invariant under rotations "
                 f"about the motor axis; {getattr(it, 'name', type(it).__name__)!r} does not say "

@@ -97,8 +97,8 @@ class SwimmerSystem(RodSystem):
     layout. ``blobs``, ``blob_radii``: the body's surface in body coordinates (core units).
     """
 
-    def __init__(self, system, blobs, blob_radii, solver: str = "direct", wall=None,
-                 wall_contact=None):
+    def __init__(self, system, blobs, blob_radii, solver: str = "direct", boundary=None,
+                 contact=None):
         from flagwrap.body.solver import make_blob_solver
 
         if not system.mobility.long_range or getattr(system.mobility, "backend", "") != "direct":
@@ -132,14 +132,20 @@ class SwimmerSystem(RodSystem):
             lambda xf: rpy_cross_block(xf, system.radius, self.blobs, self.blob_radii))
         self._geometry_y = None
         self._a_buffers = None
-        #: a no-slip plane (lab frame, core units; :mod:`flagwrap.hydrodynamics.wall`): the
-        #: blobs move against it, so the body's blob matrix, its mobility and every cross
-        #: block depend on the pose and are rebuilt per pose (:meth:`_body`); ``wall_contact``
-        #: the body's steric contact with it (a :class:`~flagwrap.interactions.wall.
-        #: WallContact`, whose law acts on the blobs' gaps)
-        self.wall = wall
-        self._wall_contact = wall_contact
+        #: a fixed no-slip boundary, a plane or a tube, as the body sees it
+        #: (:mod:`flagwrap.body.boundaries`), or None: the blobs move against it, so the
+        #: body's blob matrix, its mobility and every cross block depend on the pose and are
+        #: rebuilt per pose (:meth:`_body`); ``contact`` the steric law the beads and the
+        #: body's blobs meet it with (a :class:`~flagwrap.interactions.wall._BoundaryContact`)
+        self.boundary = boundary
+        self._boundary_contact = contact
+        #: the lab-frame plane (``[[wall]]``), or None
+        self.wall = boundary.wall if boundary is not None and boundary.kind == "wall" else None
         self._body_cache = (None, None)
+        #: the filament's own contact with the boundary (the inner system's interaction):
+        #: placed at each state's pose before its forces (:meth:`forces`)
+        self._bead_contacts = [it for it in self.interactions
+                               if getattr(it, "name", "") in ("wall contact", "tube contact")]
 
     # state ---------------------------------------------------------------------------------
     def pack(self, x, theta, phi, X=(0.0, 0.0, 0.0), q=(1.0, 0.0, 0.0, 0.0)) -> np.ndarray:
@@ -156,47 +162,95 @@ class SwimmerSystem(RodSystem):
         """``(X, R)``: the body's reference point in the lab and its rotation (body -> lab)."""
         return np.array(y[self.sl_X]), quaternion_matrix(y[self.sl_q])
 
-    # forces: RodSystem's, in the body frame (nothing depends on the pose: G's pose rows 0)
+    # forces --------------------------------------------------------------------------------
+    def forces(self, y, base):
+        """RodSystem's, in the body frame, with the filament's contact with a boundary placed
+        at ``y``'s pose (the only force that depends on the pose)."""
+        if self._bead_contacts and len(y) == self.ny:
+            self._place_contacts(y)
+        return RodSystem.forces(self, y, base)
 
-    # the wall, seen from the body ---------------------------------------------------------
+    def _contact_rotation(self, y) -> np.ndarray:
+        """Lab axes of the frame the forces are evaluated in (the body's here)."""
+        return self.pose(y)[1]
+
+    def _place_contacts(self, y) -> None:
+        X, _ = self.pose(y)
+        geometry = self.boundary.at(X, self._contact_rotation(y)).geometry
+        for it in self._bead_contacts:
+            if it.name == "wall contact":
+                it.wall = geometry
+            else:
+                it.tube = geometry
+
+    # the boundary, seen from the body -------------------------------------------------------
+    def _view(self, y):
+        """The boundary at the pose of ``y`` in body coordinates (:mod:`flagwrap.body.
+        boundaries`), kept with the pose's blob solve (:meth:`_body`), or None."""
+        if self.boundary is None:
+            return None
+        return self._body(y)[3]
+
     def _wall_body(self, y):
         """The wall in body coordinates at the pose of ``y`` (a
         :class:`~flagwrap.hydrodynamics.wall.PlaneWall`), or None."""
-        if self.wall is None:
-            return None
-        from flagwrap.hydrodynamics.wall import PlaneWall
-
-        X, R = self.pose(y)
-        return PlaneWall(R.T @ (self.wall.point - X), R.T @ self.wall.normal)
+        v = self._view(y) if self.wall is not None else None
+        return None if v is None else v.geometry
 
     def _body(self, y):
-        """``(blob solver, M_bb^-1 K, N, wall)`` at the pose of ``y``: the constant ones without
-        a wall; beside one, ``M_bb + Delta_bb(wall)`` factorised afresh for each new pose (kept
+        """``(blob solver, M_bb^-1 K, N, view)`` at the pose of ``y``: the constant ones without
+        a boundary; with one, ``M_bb + Delta_bb`` factorised afresh for each new pose (kept
         for the last pose: a step's stages revisit it)."""
-        if self.wall is None:
+        if self.boundary is None:
             return self._solver, self._MinvK, self.body_mobility, None
         key = np.array(y[self.n_in:self.n_in + 7])
         if self._body_cache[0] is not None and np.array_equal(key, self._body_cache[0]):
             return self._body_cache[1]
         from flagwrap.body.solver import DirectBlobSolver
 
-        wb = self._wall_body(y)
-        sol = DirectBlobSolver(self.blobs, self.blob_radii, wall=wb, invert=False)
+        X, R = self.pose(y)
+        view = self.boundary.at(X, R)
+        sol = DirectBlobSolver(self.blobs, self.blob_radii, invert=False,
+                               extra=view.correction_matrix(self.blobs, self.blob_radii,
+                                                            self.blobs, self.blob_radii))
         MinvK = sol.solve(self.K)
-        R = self.K.T @ MinvK
-        out = (sol, MinvK, np.linalg.inv(0.5 * (R + R.T)), wb)
+        Rm = self.K.T @ MinvK
+        out = (sol, MinvK, np.linalg.inv(0.5 * (Rm + Rm.T)), view)
         self._body_cache = (key, out)
         return out
 
-    def wall_load(self, y) -> np.ndarray:
-        """``[F; T]`` (6,) on the body from its steric contact with the wall (body axes, about
-        the reference point): the filament's contact law on each blob's gap to the plane
-        (its centre's height less its radius), zero without a wall."""
-        if self.wall is None or self._wall_contact is None:
+    def external_load(self, y) -> np.ndarray:
+        """``[F; T]`` (6,) the boundary pushes the whole swimmer with (body axes, about the
+        reference point): its contact law on each blob's gap (centre's gap less its radius)
+        and on each free bead's gap (the same forces :meth:`forces` puts in ``G``); zero
+        without a boundary. Unlike the filament's internal forces, the body does not carry
+        these back: they move the cell."""
+        if self.boundary is None or self._boundary_contact is None:
             return np.zeros(6)
-        wb = self._wall_body(y)
-        _, dU, _ = self._wall_contact.law(wb.heights(self.blobs) - self.blob_radii)
-        f = -dU[:, None] * wb.normal  # the force on each blob, body axes
+        view = self._view(y)
+        law = self._boundary_contact.law
+        g, dg = view.gap_gradient(self.blobs)
+        _, dU, _ = law(g - self.blob_radii)
+        f = -dU[:, None] * dg  # the force on each blob, body axes
+        out = np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
+        for it in self._bead_contacts:
+            x, _, _ = SwimmerSystem.unpack(self, y)
+            on = it.active
+            g, dg = view.gap_gradient(x[on])
+            _, dU, _ = it.law(g)
+            fb = -dU[:, None] * dg
+            out[:3] += fb.sum(axis=0)
+            out[3:] += np.cross(x[on], fb).sum(axis=0)
+        return out
+
+    def wall_load(self, y) -> np.ndarray:
+        """The body's own share of :meth:`external_load` (its blobs' contact), zero without a
+        boundary."""
+        if self.boundary is None or self._boundary_contact is None:
+            return np.zeros(6)
+        g, dg = self._view(y).gap_gradient(self.blobs)
+        _, dU, _ = self._boundary_contact.law(g - self.blob_radii)
+        f = -dU[:, None] * dg
         return np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
 
     # mobility ------------------------------------------------------------------------------
@@ -206,8 +260,8 @@ class SwimmerSystem(RodSystem):
         The last state's are kept: a step's stage solver and its first velocity ask at the same
         ``y``, and ``M_fb`` (beads x blobs) is the costliest thing built per call."""
         s = self
-        # beside a wall the cross block depends on the pose too
-        yin = y[:self.n_in] if self.wall is None else y[:self.n_in + 7]
+        # beside a boundary the cross block depends on the pose too
+        yin = y[:self.n_in] if self.boundary is None else y[:self.n_in + 7]
         if self._geometry_y is not None and np.array_equal(yin, self._geometry_y):
             return self._geometry_out
         from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
@@ -221,11 +275,9 @@ class SwimmerSystem(RodSystem):
             e = x[bf + 1] - x[bf]
         t = e / np.linalg.norm(e, axis=1)[:, None]
         rpy_cross_radii(xf, s.radius, self.blobs, self.blob_radii, self._cross)
-        if self.wall is not None:
-            from flagwrap.hydrodynamics.wall import wall_correction_matrix
-
-            self._cross += wall_correction_matrix(self._wall_body(y), xf, s.radius, self.blobs,
-                                                  self.blob_radii)
+        if self.boundary is not None:
+            self._cross += self._view(y).correction_matrix(xf, s.radius, self.blobs,
+                                                           self.blob_radii)
         self._geometry_y = np.array(yin)
         self._geometry_out = (xf, t, self._cross)
         return self._geometry_out
@@ -247,34 +299,38 @@ class SwimmerSystem(RodSystem):
     def body_velocity(self, y, G) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(V, v_beads, lambda)``: the body's ``[U; Omega]`` (body axes, core units), the free
         beads' lab-frame velocities in body axes, and the blob forces (core units) for the
-        generalized forces ``G`` (filament unknowns) at ``y``."""
-        return self._solve(y, G)[:3]
+        generalized forces ``G`` (filament unknowns) at ``y``: the forces of ``y`` (a
+        boundary's push, :meth:`external_load`, taken as external)."""
+        return self._solve(y, G, external=True)[:3]
 
-    def _solve(self, y, G):
-        """:meth:`body_velocity` and the geometry it used: ``(V, v, lambda, x_free, t)``."""
+    def _solve(self, y, G, external: bool = False):
+        """:meth:`body_velocity` and the geometry it used: ``(V, v, lambda, x_free, t)``.
+
+        ``external``: ``G`` is the force of ``y`` itself, whose boundary contact
+        (:meth:`external_load`) the body does not carry back (so the velocity is exact);
+        otherwise ``G`` is any vector and the map linear (``A G``, the stage solver's)."""
         s = self
         xf, t, C = self._geometry(y)
-        solver, MinvK, N, wb = self._body(y)
+        solver, MinvK, N, view = self._body(y)
         F = np.asarray(G[s.sl_x]).reshape(-1, 3)
         tau = np.asarray(G[s.sl_th])
         w = solver.solve(C.T @ F.ravel())
         load = self._load(xf, t, F, tau)
-        if wb is not None:  # an external load: the wall's push on the body
-            load = load - self.wall_load(y)
+        if external and view is not None:
+            load = load - self.external_load(y)
         V = N @ (self.K.T @ w - load)
         lam = MinvK @ V - w
         v = s.mobility.apply(xf, F) + (C @ lam).reshape(-1, 3)
-        if wb is not None:
-            from flagwrap.hydrodynamics.wall import wall_correction_apply
-
-            v += wall_correction_apply(wb, xf, s.radius, xf, s.radius, F)
+        if view is not None:
+            v += view.correction_apply(xf, s.radius, xf, s.radius, F)
         return V / s.machin, v / s.machin, lam, xf, t
 
-    def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
+    def apply_mobility(self, y, G, single: bool = False, external: bool = False) -> np.ndarray:
         """``A G`` (module docstring) over the whole state: filament rows in the body frame,
-        pose rows ``dX/dt = R U``, ``dq/dt = q (0, Omega) / 2``; the motor angle's row 0."""
+        pose rows ``dX/dt = R U``, ``dq/dt = q (0, Omega) / 2``; the motor angle's row 0.
+        ``external``: ``G`` is ``y``'s own force (:meth:`_solve`)."""
         s = self
-        V, v, _, xf, t = self._solve(y, G)
+        V, v, _, xf, t = self._solve(y, G, external)
         U, Om = V[:3], V[3:]
         out = np.zeros(self.ny)
         out[s.sl_x] = (v - U - xf @ cross_matrix(Om).T).ravel()
@@ -285,7 +341,7 @@ class SwimmerSystem(RodSystem):
         return out
 
     def velocity(self, y, info, omega: float) -> np.ndarray:
-        f = self.apply_mobility(y, info.G)
+        f = self.apply_mobility(y, info.G, external=True)
         f[self.sl_phi] = self.motor_rate(y, info, omega)
         return f
 
@@ -310,17 +366,15 @@ class SwimmerSystem(RodSystem):
             A.fill(0.0)
         else:
             A, tmp, Mff = np.zeros((self.n_in, self.n_in)), None, None
-        solver, MinvK, N, wb = self._body(y)
+        solver, MinvK, N, view = self._body(y)
         A[:n3, :n3] = s.mobility.matrix(xf, out=Mff)
-        if wb is not None:
-            from flagwrap.hydrodynamics.wall import wall_correction_matrix
-
-            A[:n3, :n3] += wall_correction_matrix(wb, xf, s.radius)
+        if view is not None:
+            A[:n3, :n3] += view.correction_matrix(xf, s.radius)
         if screening == "lagged":
             S = self._lagged(xf)
             if S is not None:  # None: a Krylov blob solver, W goes without
                 A[:n3, :n3] -= S
-        elif screening:  # with the pose's own blob matrix beside a wall
+        elif screening:  # with the pose's own blob matrix beside a boundary
             from flagwrap.body.solver import screening_matrix
 
             A[:n3, :n3] -= screening_matrix(solver, C)
@@ -487,14 +541,22 @@ def make_swimmer(config):
     fil = config.filament
     inner = RodSystem(config, mobility=RPYMobility(fil.bead_radius / fil.length))
     blobs, radii = cell_body_blobs(config)
-    contact = None
-    if inner.wall is not None:  # the system's plane (config_wall), seen by the body too
-        from flagwrap.interactions.wall import WallContact, contact_law
+    boundary = contact = None
+    if inner.wall is not None or inner.tube is not None:
+        # the system's plane (config_wall) or tube (config_tube), seen by the body too
+        from flagwrap.body.boundaries import TubeFromBody, WallFromBody
+        from flagwrap.interactions.wall import _BoundaryContact, contact_law
 
+        if inner.wall is not None:
+            boundary = WallFromBody(inner.wall)
+        else:
+            from flagwrap.system.parts import tube_blobs
+
+            boundary = TubeFromBody(inner.tube, *tube_blobs(config))
         cutoff, strength, c2 = contact_law(config, inner.bond)
-        contact = WallContact(inner.wall, cutoff, strength, np.ones(len(blobs), bool), c2=c2)
-    return SwimmerSystem(inner, blobs, radii, solver=config.body.solver, wall=inner.wall,
-                         wall_contact=contact)
+        contact = _BoundaryContact(cutoff, strength, np.ones(len(blobs), bool), c2=c2)
+    return SwimmerSystem(inner, blobs, radii, solver=config.body.solver, boundary=boundary,
+                         contact=contact)
 
 
 class SwimmerKrylovW(KrylovW):
@@ -600,10 +662,7 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
 
         if type(swimmer) is not SwimmerSystem:
             raise ValueError("SwimmerRotating: a SwimmerSystem")
-        check_rotating_frame(swimmer, blob_body=True)
-        if swimmer.wall is not None:
-            raise ValueError("SwimmerRotating: a free cell beside a wall (the wall moves "
-                             "in the body's frame)")
+        check_rotating_frame(swimmer, blob_body=True, placed=swimmer._bead_contacts)
         self.__dict__.update(swimmer.__dict__)  # the same parts and buffers: a view
         self.axis = np.asarray(swimmer.joint.axis, float)
         self._A = cross_matrix(self.axis)
@@ -637,6 +696,16 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
         return yr, Frames(t @ R, d1 @ R, base.rt)
 
     # forces at the clamp's reference angle (AtReferenceAngle) ---------------------------
+    def forces(self, y, base):
+        """The body frame's forces with the clamp at ``phi = 0``; a boundary's contact placed
+        as this frame sees it (the body's pose, then turned back by ``phi``)."""
+        if self._bead_contacts and len(y) == self.ny:
+            self._place_contacts(y)
+        return RodSystem.forces(self, self._at_zero(y), base)
+
+    def _contact_rotation(self, y) -> np.ndarray:
+        return self.pose(y)[1] @ self._turn(y)
+
     def motor_rate(self, y, info, omega: float):
         return SwimmerSystem.motor_rate(self, self._at_zero(y), info, omega)
 
@@ -663,12 +732,12 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
         WT[:, :i] -= np.outer(col, c)
 
     # mobility ------------------------------------------------------------------------------
-    def apply_mobility(self, y, G, single: bool = False) -> np.ndarray:
+    def apply_mobility(self, y, G, single: bool = False, external: bool = False) -> np.ndarray:
         """``R^T A'(R x'') R G``: the body frame's product at the turned positions, its bead
         rows turned back; the pose rows are the body's own."""
         R = self._turn(y)
         yb, Gb = self._to_body(y, G, R)
-        out = SwimmerSystem.apply_mobility(self, yb, Gb, single)
+        out = SwimmerSystem.apply_mobility(self, yb, Gb, single, external)
         sx = self.sl_x
         out[sx] = (out[sx].reshape(-1, 3) @ R).ravel()
         return out
@@ -676,7 +745,7 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
     def velocity(self, y, info, omega: float) -> np.ndarray:
         from flagwrap.system.rotating import subtract_rotation
 
-        f = self.apply_mobility(y, info.G)
+        f = self.apply_mobility(y, info.G, external=True)
         w = self.motor_rate(y, info, omega)
         subtract_rotation(f, self, info, w, self.axis, self._A)
         f[self.sl_phi] = w

@@ -1,0 +1,181 @@
+"""A fixed no-slip boundary seen from a moving body: what a free cell needs of a plane wall or
+a tube at each pose of its body (:class:`~flagwrap.system.swimmer.SwimmerSystem` steps in the
+body's frame, where the boundary is what moves).
+
+A boundary enters the free cell's mobility problem as an addition ``Delta`` to the free-space
+RPY blocks among everything that moves (the filament's beads and the body's blobs), and as a
+steric wall the beads and blobs meet:
+
+* **A plane** (:class:`WallFromBody`): ``Delta`` is the Rotne-Prager-Blake correction
+  (:mod:`flagwrap.hydrodynamics.wall`, Swan & Brady 2007) about the plane in body
+  coordinates.
+* **A tube** (:class:`TubeFromBody`): a shell of ``T`` no-slip blobs held still in the lab
+  (:mod:`flagwrap.confinement.tube`). Eliminating their forces from the joint blob problem
+  (Usabiaga et al. 2016, Sec. 3: every blob's velocity is its rigid motion, zero for the
+  tube) leaves the Schur complement
+
+      Delta_ij = - M_iT M_TT^-1 M_Tj,
+
+  the tube's screening between any two moving spheres ``i, j``. ``M_TT`` is the tube's own
+  RPY matrix: it does not change, so it is factorised (and up to 2500 blobs inverted) once.
+  ``M_iT`` is the free RPY block between a moving sphere and the tube's blobs, built at the
+  sphere's lab position and turned into body axes: ``Delta`` in body axes is
+  ``R^T Delta_lab R`` on each block (rotation covariance of RPY, exact).
+
+Both give, at one pose, a *view* (:meth:`at`) with the same small interface: the body-frame
+geometry (for contact), gaps and their gradients, ``Delta`` as a matrix or applied. The view
+of a tube keeps ``L^-1 M_Tb`` of the body's blobs (``M_TT = L L^T``), the costliest thing a
+pose needs (``27 T^2 n_b`` operations; docs/confinement.md, "A free cell in a tube").
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import scipy.linalg as sla
+
+from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
+from flagwrap.hydrodynamics.wall import (
+    PlaneWall,
+    wall_correction_apply,
+    wall_correction_matrix,
+)
+
+
+def _cross_lab(x, radii, blobs, blob_radii) -> np.ndarray:
+    """The free RPY block (3n, 3T) between spheres at ``x`` of ``radii`` and the boundary's
+    blobs (lab frame): :func:`~flagwrap.hydrodynamics.polydisperse.rpy_cross_radii` once
+    per distinct radius of the spheres (a filament's beads share one; a body's blobs do)."""
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    radii = np.broadcast_to(np.asarray(radii, float), (len(x),))
+    out = np.empty((3 * len(x), 3 * len(blobs)))
+    values = np.unique(radii)
+    if len(values) == 1:
+        rpy_cross_radii(x, float(values[0]), blobs, blob_radii, out)
+        return out
+    for a in values:
+        ids = np.flatnonzero(radii == a)
+        part = np.empty((3 * len(ids), 3 * len(blobs)))
+        rpy_cross_radii(np.ascontiguousarray(x[ids]), float(a), blobs, blob_radii, part)
+        rows = (3 * ids[:, None] + np.arange(3)).ravel()
+        out[rows] = part
+    return out
+
+
+class WallView:
+    """The plane at one pose, in body coordinates."""
+
+    def __init__(self, wall: PlaneWall, X, R):
+        self.geometry = PlaneWall(R.T @ (wall.point - X), R.T @ wall.normal)
+
+    def gap_gradient(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """``(gap, grad gap)`` of points ``x`` (n, 3): heights above the plane, its normal."""
+        g = self.geometry.heights(x)
+        return g, np.broadcast_to(self.geometry.normal, (len(g), 3))
+
+    def correction_matrix(self, xt, at, xs=None, as_=None) -> np.ndarray:
+        return wall_correction_matrix(self.geometry, xt, at, xs, as_)
+
+    def correction_apply(self, xt, at, xs, as_, F) -> np.ndarray:
+        return wall_correction_apply(self.geometry, xt, at, xs, as_, F)
+
+
+class WallFromBody:
+    """A plane wall (lab frame, core units) as a free body sees it (module docstring)."""
+
+    kind = "wall"
+
+    def __init__(self, wall: PlaneWall):
+        self.wall = wall
+        self.lab_geometry = wall
+
+    def at(self, X, R) -> WallView:
+        return WallView(self.wall, X, R)
+
+
+class TubeView:
+    """The tube at one pose (module docstring): body-frame geometry and the screening
+    ``Delta`` between moving spheres, built from the lab-frame factor of ``M_TT``."""
+
+    def __init__(self, owner: TubeFromBody, X, R):
+        self.owner, self.X, self.R = owner, np.asarray(X, float), np.asarray(R, float)
+        t = owner.tube
+        self.geometry = dataclasses.replace(
+            t, center=tuple(R.T @ (np.asarray(t.center) - X)), axis=tuple(R.T @ np.asarray(t.axis)))
+        self._kept = None  # (x, L^-1 C^T) of the last source set asked twice (the blobs)
+
+    def gap_gradient(self, x) -> tuple[np.ndarray, np.ndarray]:
+        g, dg, _, _ = self.geometry.gap_gradient(x)
+        return g, dg
+
+    def cross(self, x, radii) -> np.ndarray:
+        """``M_xT`` (3n, 3T): rows in body axes at body-frame ``x``, columns the tube blobs'
+        lab-frame forces."""
+        o, R = self.owner, self.R
+        C = _cross_lab(np.asarray(x) @ R.T + self.X, radii, o.blobs, o.blob_radii)
+        n = len(x)
+        # R^T on each row block: C_body[i] = R^T C_lab[i]
+        return np.einsum("ba,nbk->nak", R, C.reshape(n, 3, -1)).reshape(3 * n, -1)
+
+    def _half(self, C) -> np.ndarray:
+        """``Z = L^-1 C^T`` with ``M_TT = L L^T``: ``Delta = -Z_t^T Z_s`` (one triangular solve
+        and one product: half the operations of ``C_t (M_TT^-1 C_s^T)``)."""
+        return sla.solve_triangular(self.owner.solver._L, np.ascontiguousarray(C.T), lower=True,
+                                    check_finite=False)
+
+    def _source(self, xs, as_):
+        """``Z_s`` of the sources, kept when they are the same array object as last time (a
+        body's blobs: asked by every product at this pose)."""
+        k = self._kept
+        if k is not None and k[0] is xs:
+            return k[1]
+        Z = self._half(self.cross(xs, as_))
+        self._kept = (xs, Z)
+        return Z
+
+    def correction_matrix(self, xt, at, xs=None, as_=None) -> np.ndarray:
+        """``Delta`` (3n, 3m) between targets and sources (default: the targets)."""
+        if xs is None:
+            Z = self._half(self.cross(xt, at))
+            return -_gram(Z)
+        Zs = self._source(xs, as_)
+        if xt is xs:
+            return -_gram(Zs)
+        return -(self._half(self.cross(xt, at)).T @ Zs)
+
+    def correction_apply(self, xt, at, xs, as_, F) -> np.ndarray:
+        """``Delta F`` (n, 3) at the targets, no (3n, 3m) matrix: two cross blocks and one
+        solve with ``M_TT``."""
+        Cs = self.cross(xs, as_)
+        Ct = Cs if (xt is xs) else self.cross(xt, at)
+        return -(Ct @ self.owner.solver.solve(Cs.T @ np.asarray(F, float).ravel())).reshape(-1, 3)
+
+
+def _gram(Z) -> np.ndarray:
+    """``Z^T Z`` by BLAS syrk (one triangle, then mirrored)."""
+    from scipy.linalg.blas import dsyrk
+
+    G = dsyrk(1.0, np.asfortranarray(Z), trans=1, lower=0)
+    return np.triu(G) + np.triu(G, 1).T
+
+
+class TubeFromBody:
+    """A tube (:class:`flagwrap.confinement.tube.Tube`, core units) of no-slip ``blobs`` held
+    still in the lab, as a free body sees it (module docstring). ``M_TT`` is factorised here,
+    once (:class:`~flagwrap.body.solver.DirectBlobSolver`)."""
+
+    kind = "tube"
+
+    def __init__(self, tube, blobs, blob_radii):
+        from flagwrap.body.solver import DirectBlobSolver
+
+        self.tube = tube
+        self.lab_geometry = tube
+        self.blobs = np.ascontiguousarray(blobs, dtype=np.float64)
+        self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
+                                               dtype=np.float64)
+        self.solver = DirectBlobSolver(self.blobs, self.blob_radii)  # its factor L: Delta
+
+    def at(self, X, R) -> TubeView:
+        return TubeView(self, X, R)
