@@ -200,3 +200,40 @@ def test_the_fluid_takes_the_boundarys_push(extra, rng):
     h = 1e-7
     grad = [(energy(h * e) - energy(-h * e)) / (2 * h) for e in np.eye(3)]
     assert np.allclose(-np.array(grad), ext[:3], rtol=1e-5, atol=1e-6 * np.abs(ext[:3]).max())
+
+
+def test_screened_blob_solve_away_from_its_reference_is_the_exact_one(rng):
+    """The body's blob solve in a tube at a pose other than its factor's (conjugate gradients
+    preconditioned by the reference factor) against the exact matrix of that pose solved
+    densely: 1e-8 (CG stops at 1e-11 of the residual; the matrix's condition number ~1e3);
+    at the reference pose it is the factor's own solve (1e-11: two dense solves' rounding); a solve that needs more than
+    ``refresh_iterations`` rebuilds the factor at its pose."""
+    t = Tube(1.0, 3.0)
+    tube = TubeFromBody(t, t.blob_shell(0.25, 0.25), 0.25)
+    sb, ab = _sphere(0.5)
+    radii = np.full(len(sb), ab)
+    K = geometric_matrix(sb)
+    M0 = PolydisperseRPY(radii).matrix(sb)
+
+    def exact(X, R):
+        M = M0 + tube.at(X, R).correction_matrix(sb, radii, sb, radii)
+        return np.linalg.solve(M, K)
+
+    key0 = np.array([0, 0, 0, 1.0, 0, 0, 0])
+    s0 = tube.blob_solver(tube.at(np.zeros(3), np.eye(3)), sb, radii, key0)
+    X = np.array([0.01, -0.005, 0.02])
+    q = np.array([1.0, 0.01, -0.01, 0.1]) / np.linalg.norm([1.0, 0.01, -0.01, 0.1])
+    R = quaternion_matrix(q)
+    ref0 = exact(np.zeros(3), np.eye(3))
+    assert np.abs(s0.solve(K) - ref0).max() < 1e-11 * np.abs(ref0).max()
+    assert tube.refreshed == 1
+    s1 = tube.blob_solver(tube.at(X, R), sb, radii, np.concatenate([X, q]))
+    before = tube.iterations
+    x1 = s1.solve(K)
+    assert tube.refreshed == 1 and tube.iterations > before  # iterated, no new factor
+    ref = exact(X, R)
+    assert np.abs(x1 - ref).max() < 1e-8 * np.abs(ref).max()
+    tube.refresh_iterations = 1  # now too few: the factor moves here, the solve exact
+    x2 = s1.solve(K)
+    assert tube.refreshed == 2 and np.array_equal(tube.memory(), np.concatenate([X, q]))
+    assert np.abs(x2 - ref).max() < 1e-11 * np.abs(ref).max()

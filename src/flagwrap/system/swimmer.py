@@ -199,20 +199,17 @@ class SwimmerSystem(RodSystem):
 
     def _body(self, y):
         """``(blob solver, M_bb^-1 K, N, view)`` at the pose of ``y``: the constant ones without
-        a boundary; with one, ``M_bb + Delta_bb`` factorised afresh for each new pose (kept
-        for the last pose: a step's stages revisit it)."""
+        a boundary; with one, the solve with ``M_bb + Delta_bb`` at this pose (the boundary's
+        :meth:`blob_solver`: factorised afresh beside a wall, conjugate gradients from a
+        reference factor in a tube), kept for the last pose (a step's stages revisit it)."""
         if self.boundary is None:
             return self._solver, self._MinvK, self.body_mobility, None
         key = np.array(y[self.n_in:self.n_in + 7])
         if self._body_cache[0] is not None and np.array_equal(key, self._body_cache[0]):
             return self._body_cache[1]
-        from flagwrap.body.solver import DirectBlobSolver
-
         X, R = self.pose(y)
         view = self.boundary.at(X, R)
-        sol = DirectBlobSolver(self.blobs, self.blob_radii, invert=False,
-                               extra=view.correction_matrix(self.blobs, self.blob_radii,
-                                                            self.blobs, self.blob_radii))
+        sol = self.boundary.blob_solver(view, self.blobs, self.blob_radii, key)
         MinvK = sol.solve(self.K)
         Rm = self.K.T @ MinvK
         out = (sol, MinvK, np.linalg.inv(0.5 * (Rm + Rm.T)), view)
@@ -260,8 +257,7 @@ class SwimmerSystem(RodSystem):
         The last state's are kept: a step's stage solver and its first velocity ask at the same
         ``y``, and ``M_fb`` (beads x blobs) is the costliest thing built per call."""
         s = self
-        # beside a boundary the cross block depends on the pose too
-        yin = y[:self.n_in] if self.boundary is None else y[:self.n_in + 7]
+        yin = y[:self.n_in]  # the boundary's Delta is applied apart (_solve)
         if self._geometry_y is not None and np.array_equal(yin, self._geometry_y):
             return self._geometry_out
         from flagwrap.hydrodynamics.polydisperse import rpy_cross_radii
@@ -275,19 +271,28 @@ class SwimmerSystem(RodSystem):
             e = x[bf + 1] - x[bf]
         t = e / np.linalg.norm(e, axis=1)[:, None]
         rpy_cross_radii(xf, s.radius, self.blobs, self.blob_radii, self._cross)
-        if self.boundary is not None:
-            self._cross += self._view(y).correction_matrix(xf, s.radius, self.blobs,
-                                                           self.blob_radii)
         self._geometry_y = np.array(yin)
         self._geometry_out = (xf, t, self._cross)
         return self._geometry_out
 
     def solver_memory(self) -> np.ndarray:
         """What the stage solver carries from step to step: the lagged screening's
-        (:meth:`~flagwrap.body.solver.LaggedScreening.memory`)."""
-        return self._lagged.memory()
+        (:meth:`~flagwrap.body.solver.LaggedScreening.memory`); with a boundary, then its own
+        (a tube's reference pose) and that part's length."""
+        m = self._lagged.memory()
+        if self.boundary is None:
+            return m
+        b = self.boundary.memory()
+        return np.concatenate([m, b, [float(len(b))]])
 
     def restore_solver_memory(self, memory) -> None:
+        memory = np.asarray(memory, float)
+        if self.boundary is not None:
+            k = int(memory[-1]) if memory.size else 0
+            self.boundary.restore(memory[len(memory) - 1 - k:-1] if memory.size else memory,
+                                  self.blobs, self.blob_radii)
+            self._body_cache = (None, None)
+            memory = memory[:len(memory) - 1 - k] if memory.size else memory
         self._lagged.restore(memory)
 
     def _load(self, xf, t, F, tau) -> np.ndarray:
@@ -314,15 +319,20 @@ class SwimmerSystem(RodSystem):
         solver, MinvK, N, view = self._body(y)
         F = np.asarray(G[s.sl_x]).reshape(-1, 3)
         tau = np.asarray(G[s.sl_th])
-        w = solver.solve(C.T @ F.ravel())
+        Ff = F.ravel()
+        b, rb = self.blobs, self.blob_radii
+        u = C.T @ Ff  # M_bf F, and beside a boundary its Delta_bf F
+        if view is not None:
+            u += view.apply(b, rb, [(xf, s.radius, Ff)])
+        w = solver.solve(u)
         load = self._load(xf, t, F, tau)
         if external and view is not None:
             load = load - self.external_load(y)
         V = N @ (self.K.T @ w - load)
         lam = MinvK @ V - w
         v = s.mobility.apply(xf, F) + (C @ lam).reshape(-1, 3)
-        if view is not None:
-            v += view.correction_apply(xf, s.radius, xf, s.radius, F)
+        if view is not None:  # Delta_fb lambda + Delta_ff F
+            v += view.apply(xf, s.radius, [(b, rb, lam), (xf, s.radius, Ff)]).reshape(-1, 3)
         return V / s.machin, v / s.machin, lam, xf, t
 
     def apply_mobility(self, y, G, single: bool = False, external: bool = False) -> np.ndarray:
@@ -377,12 +387,17 @@ class SwimmerSystem(RodSystem):
         elif screening:  # with the pose's own blob matrix beside a boundary
             from flagwrap.body.solver import screening_matrix
 
-            A[:n3, :n3] -= screening_matrix(solver, C)
+            Ct = C if view is None else C + view.correction_matrix(xf, s.radius, self.blobs,
+                                                                   self.blob_radii)
+            A[:n3, :n3] -= screening_matrix(solver, Ct)
         idx = np.arange(n3, n3 + s.ne)
         A[idx, idx] = s.twist_mobility * s.machin
         D = np.zeros((6, self.n_in))
         # - S: the beads' rigid-motion matrix transposed, [I; [x]_x] per bead; [0; t] per bond
-        D[:, :n3] = (C @ MinvK).T - geometric_matrix(xf).T
+        CK = C @ MinvK
+        if view is not None:  # (M_fb + Delta_fb) M~_bb^-1 K
+            CK += view.apply(xf, s.radius, [(self.blobs, self.blob_radii, MinvK)])
+        D[:, :n3] = CK.T - geometric_matrix(xf).T
         D[3:, n3:n3 + s.ne] -= t.T
         ND = N @ D
         A += np.matmul(D.T, ND, out=tmp)

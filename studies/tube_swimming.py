@@ -1,0 +1,167 @@
+"""The extended and the wrapped S. putrefaciens cell swimming along straight tubes of
+decreasing radius, against free space (docs/confinement.md, "A free cell in a tube").
+
+Run: ``python studies/tube_swimming.py [--radii 3 2 1.5] [--turns 3] [--spacing 0.4]
+[--out out/tube_swimming]``
+
+1. The two swimming states, from ``examples/s_putrefaciens_wrap.toml`` (speed motor, 50 Hz)
+   in the motor's frame: **extended**, the end of its 4 CCW turns (the coil pushes from
+   behind); **wrapped**, the end of its whole protocol (4 CCW + 12 CW: wrapped round the body).
+2. Each state with its body put back at the origin, unturned (free space is invariant under
+   a rigid motion; the tube is placed about the body's axis), then ``--turns`` more reference
+   turns in its direction: in free space, and inside an open straight tube about the body's
+   axis (its middle ``--centre`` um below the motor, ``--length`` um long: the coil reaches
+   2.9 um below the motor, the body 2.5 um above it) of each radius in
+   ``--radii`` um, blobs ``--spacing`` um apart (each run's own ``flagwrap analyze``
+   numbers: the speed along the tube and Lighthill's efficiency over the last turn).
+
+Prints one table row per (state, radius): steps, seconds, the body's distance from the axis,
+the swimming speed along the tube, the motor's torque and power, and the efficiency, each
+also against free space. Each run file is kept in ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from flagwrap.cases import case_files
+from flagwrap.io.config import load_config
+from flagwrap.params import Phase
+from flagwrap.simulation import Simulation
+
+
+def base_config(turns, direction, frame="rotating"):
+    cfg = load_config(case_files()["s_putrefaciens_wrap"])
+    return cfg.replace(
+        motor=dataclasses.replace(cfg.motor, protocol=turns if isinstance(turns, tuple)
+                                  else (Phase(direction, turns),)),
+        numerics=dataclasses.replace(cfg.numerics, frame=frame))
+
+
+def with_tube(cfg, radius_um, length_um, centre_um, spacing_um):
+    from flagwrap.params import TubeWall
+
+    um = 1e-6  # the config is in SI once loaded
+    tube = TubeWall(radius=radius_um * um, length=length_um * um,
+                      center=(0.0, 0.0, -centre_um * um), axis=(0.0, 0.0, 1.0),
+                      blob_spacing=spacing_um * um)
+    return cfg.replace(tubes=(tube,))
+
+
+def states(out: Path):
+    """``{"extended": (y, frames), "wrapped": (y, frames)}`` in the motor's frame (kept in
+    ``out/states.npz`` and read back from it when there)."""
+    from flagwrap.elasticity.rod import Frames
+
+    cache = out / "states.npz"
+    if cache.exists():
+        z = np.load(cache)
+        return {n: (z[f"{n}_y"], Frames(z[f"{n}_t"], z[f"{n}_d1"], z[f"{n}_rt"]))
+                for n in ("extended", "wrapped")}
+    found, keep = {}, {}
+    for name, protocol in (("extended", (Phase("ccw", 4.0),)),
+                           ("wrapped", (Phase("ccw", 4.0), Phase("cw", 12.0)))):
+        start = time.perf_counter()
+        tr = Simulation(base_config(protocol, None)).run()
+        print(f"{name} state: {tr.status}, {tr.n_steps} steps, "
+              f"{time.perf_counter() - start:.0f} s", flush=True)
+        fr = tr.final_frames
+        found[name] = (tr.final_y, fr)
+        keep.update({f"{name}_y": tr.final_y, f"{name}_t": fr.t, f"{name}_d1": fr.d1,
+                     f"{name}_rt": fr.rt})
+    np.savez(cache, **keep)
+    return found
+
+
+def at_origin(system, y):
+    y = np.array(y, float)
+    y[system.sl_X] = 0.0
+    y[system.sl_q] = (1.0, 0.0, 0.0, 0.0)
+    return y
+
+
+def run_one(cfg, y0, base, path):
+    from flagwrap.io.runfile import write_run
+
+    sim = Simulation(cfg)
+    y = at_origin(sim.system, y0)
+    start = time.perf_counter()
+    t_end = 2 * math.pi * sum(p.turns for p in cfg.motor.protocol)
+    tr = sim.run(t_end=t_end, y0=y, base=base, t0=0.0)
+    wall = time.perf_counter() - start
+    write_run(tr, path)
+    return tr, wall
+
+
+def measure(path, final_turns: float = 1.0):
+    """The last ``final_turns`` reference turns of a run file: the swimming summary (speed,
+    motor power, Lighthill's efficiency) and the tube's (None in free space)."""
+    from flagwrap.io.runfile import read_run
+    from flagwrap.observables.swimming import swimming_summary
+    from flagwrap.observables.wall import wall_summary
+
+    ds = read_run(path)
+    return swimming_summary(ds, final_turns)[-1], wall_summary(ds, final_turns)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser()
+    p.add_argument("--radii", type=float, nargs="+", default=[3.0, 2.0, 1.5])
+    p.add_argument("--turns", type=float, default=3.0)
+    p.add_argument("--spacing", type=float, default=0.4,
+                   help="blob spacing [um], at most --max-ratio times the radius")
+    p.add_argument("--max-ratio", type=float, default=0.25)
+    p.add_argument("--length", type=float, default=10.0)
+    p.add_argument("--centre", type=float, default=0.2)
+    p.add_argument("--modes", nargs="+", default=["extended", "wrapped"])
+    p.add_argument("--out", default="out/tube_swimming")
+    args = p.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    found = states(out)
+    rows = []
+    for mode in args.modes:
+        y0, base = found[mode]
+        direction = "ccw" if mode == "extended" else "cw"
+        for radius in [None, *args.radii]:
+            cfg = base_config(args.turns, direction)
+            h = args.spacing if radius is None else min(args.spacing, args.max_ratio * radius)
+            if radius is not None:
+                cfg = with_tube(cfg, radius, args.length, args.centre, h)
+            tag = "free" if radius is None else f"R{radius:g}"
+            path = out / f"{mode}_{tag}_h{h:g}.nc"
+            tr, wall = run_one(cfg, y0, base, path)
+            final, w = measure(path)
+            rows.append((mode, radius, tr, wall, final, w, h))
+            print(f"{mode} {tag}: {tr.status} {tr.n_steps} steps ({tr.n_rejected} rejected) "
+                  f"{wall:.0f} s; speed {final['speed'] * 1e6:.3f} um/s, "
+                  f"efficiency {final['efficiency'] * 100:.3g} %"
+                  + ("" if w is None else f", along the tube {w['speed_along'] * 1e6:+.3f} um/s,"
+                     f" body {w['body_axis_distance_final'] * 1e6:.3f} um from the axis, "
+                     f"closest bead {w['gap_min'] * 1e9:.0f} nm"), flush=True)
+    print("\n| state | tube radius [um] | steps | s | speed [um/s] | vs free | motor power "
+          "[fW] | efficiency [%] | vs free | body off axis [um] | closest bead [nm] |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    free = {}
+    for mode, radius, tr, wall, final, w, h in rows:
+        if radius is None:
+            free[mode] = final
+        f0 = free[mode]
+        off = "-" if w is None else f"{w['body_axis_distance_final'] * 1e6:.3f}"
+        gap = "-" if w is None else f"{w['gap_min'] * 1e9:.0f}"
+        where = "free" if radius is None else f"{radius:g} (blobs {h:g} apart)"
+        print(f"| {mode} | {where} | {tr.n_steps} | {wall:.0f} | {final['speed'] * 1e6:.3f} | "
+              f"{final['speed'] / f0['speed']:.3f} | {final['motor_power'] * 1e15:.3g} | "
+              f"{final['efficiency'] * 100:.3g} | {final['efficiency'] / f0['efficiency']:.3f} "
+              f"| {off} | {gap} |")
+
+if __name__ == "__main__":
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    main()
