@@ -191,12 +191,6 @@ class SwimmerSystem(RodSystem):
             return None
         return self._body(y)[3]
 
-    def _wall_body(self, y):
-        """The wall in body coordinates at the pose of ``y`` (a
-        :class:`~flagwrap.hydrodynamics.wall.PlaneWall`), or None."""
-        v = self._view(y) if self.wall is not None else None
-        return None if v is None else v.geometry
-
     def _body(self, y):
         """``(blob solver, M_bb^-1 K, N, view)`` at the pose of ``y``: the constant ones without
         a boundary; with one, the solve with ``M_bb + Delta_bb`` at this pose (the boundary's
@@ -222,14 +216,10 @@ class SwimmerSystem(RodSystem):
         and on each free bead's gap (the same forces :meth:`forces` puts in ``G``); zero
         without a boundary. Unlike the filament's internal forces, the body does not carry
         these back: they move the cell."""
-        if self.boundary is None or self._boundary_contact is None:
-            return np.zeros(6)
+        out = self.wall_load(y)
+        if self.boundary is None:
+            return out
         view = self._view(y)
-        law = self._boundary_contact.law
-        g, dg = view.gap_gradient(self.blobs)
-        _, dU, _ = law(g - self.blob_radii)
-        f = -dU[:, None] * dg  # the force on each blob, body axes
-        out = np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
         for it in self._bead_contacts:
             x, _, _ = SwimmerSystem.unpack(self, y)
             on = it.active
@@ -247,7 +237,7 @@ class SwimmerSystem(RodSystem):
             return np.zeros(6)
         g, dg = self._view(y).gap_gradient(self.blobs)
         _, dU, _ = self._boundary_contact.law(g - self.blob_radii)
-        f = -dU[:, None] * dg
+        f = -dU[:, None] * dg  # the force on each blob, body axes
         return np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
 
     # mobility ------------------------------------------------------------------------------
