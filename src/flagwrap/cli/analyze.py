@@ -154,7 +154,8 @@ def run(args) -> int:
         for ph in res["swimming"]:  # a free swimmer, phase by phase (second half of each)
             what = "last turns" if ph["direction"] == "final" else f"{ph['direction']} phase"
             print(f"  swimming, {what} ({ph['t0']:.3g}-{ph['t1']:.3g} s): "
-                  f"speed {ph['speed'] * 1e6:+.4g} um/s (+ body first), body rotation "
+                  f"speed {ph['speed'] * 1e6:+.4g} um/s (+ body first; "
+                  f"{ph['screw_speed'] * 1e6:+.4g} along the path's screw axis), body rotation "
                   f"{ph['body_rotation_hz']:+.4g} Hz, motor {ph['motor_rate_hz']:+.4g} Hz, "
                   f"{ph['displacement_per_turn'] * 1e9:+.4g} nm per motor turn, motor power "
                   f"{ph['motor_power']:.4g} W, Lighthill efficiency "
