@@ -119,17 +119,17 @@ def measure(path, final_turns: float = 2.0):
     final = swimming_summary(ds, final_turns)[-1]
     w = wall_summary(ds, final_turns)
     U = final["screw_speed"] if w is None else w["speed_along"]  # the tube's axis: the body's
-    final.update(U=U, eta=body_drag(config_of(ds)) * U * U / final["motor_power"])
+    final.update(U=U, eta=body_drag(config_of(ds)) * U * U / final["motor_power"],
+                 per_turn=per_turn(ds))
     return final, w
 
 
-def per_turn(path) -> list[float]:
-    """The screw speed [m/s] over each whole reference turn of a run file (its convergence:
-    a periodic swimmer gives the same number every turn)."""
-    from flagwrap.io.runfile import config_of, read_run
+def per_turn(ds) -> list[float]:
+    """The screw speed [m/s] over each whole reference turn of a run file's dataset (its
+    convergence: a periodic swimmer gives the same number every turn)."""
+    from flagwrap.io.runfile import config_of
     from flagwrap.observables.swimming import phase_summary
 
-    ds = read_run(path)
     t = ds["time"].values
     T = 2 * math.pi / config_of(ds).scales.omega
     args = (ds["motor_angle"].values, ds["body_position"].values, ds["body_orientation"].values)
@@ -179,12 +179,11 @@ def main(argv=None):
                   + ("" if w is None else f", along the tube {w['speed_along'] * 1e6:+.3f} um/s,"
                      f" body {w['body_axis_distance_final'] * 1e6:.3f} um from the axis, "
                      f"closest bead {w['gap_min'] * 1e9:.0f} nm")
-                  + "; screw speed per turn " + " ".join(f"{u * 1e6:+.3f}" for u in per_turn(path)),
+                  + "; screw speed per turn " + " ".join(f"{u * 1e6:+.3f}" for u in final["per_turn"]),
                   flush=True)
     print("\n| state | tube radius [um] | steps | s | speed [um/s] | vs free | motor power "
           "[fW] | efficiency [%] | vs free | body off axis [um] | closest bead [nm] |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    speed, eff = "U", "eta"
     free = {}
     for mode, radius, tr, wall, final, w, h in rows:
         if radius is None:
@@ -193,9 +192,9 @@ def main(argv=None):
         off = "-" if w is None else f"{w['body_axis_distance_final'] * 1e6:.3f}"
         gap = "-" if w is None else f"{w['gap_min'] * 1e9:.0f}"
         where = "free" if radius is None else f"{radius:g} (blobs {h:g} apart)"
-        print(f"| {mode} | {where} | {tr.n_steps} | {wall:.0f} | {final[speed] * 1e6:.3f} | "
-              f"{final[speed] / f0[speed]:.3f} | {final['motor_power'] * 1e15:.3g} | "
-              f"{final[eff] * 100:.3g} | {final[eff] / f0[eff]:.3f} "
+        print(f"| {mode} | {where} | {tr.n_steps} | {wall:.0f} | {final['U'] * 1e6:.3f} | "
+              f"{final['U'] / f0['U']:.3f} | {final['motor_power'] * 1e15:.3g} | "
+              f"{final['eta'] * 100:.3g} | {final['eta'] / f0['eta']:.3f} "
               f"| {off} | {gap} |")
 
 if __name__ == "__main__":

@@ -68,16 +68,14 @@ def per_turn_track(path):
     the centre's displacement in the wall's plane [rad, unwrapped, about the normal] and the
     speed along the wall [m/s]."""
     from flagwrap.io.runfile import config_of, read_run
-    from flagwrap.observables.swimming import quaternion_matrices
-    from flagwrap.observables.wall import body_centre
+    from flagwrap.observables.wall import body_centres
 
     ds = read_run(path)
     cfg = config_of(ds)
     w = cfg.walls[0]
     n, p = w.unit_normal, np.asarray(w.point, float)
     t = ds["time"].values
-    R = quaternion_matrices(ds["body_orientation"].values)
-    c = ds["body_position"].values + R @ body_centre(cfg)
+    R, c = body_centres(ds, cfg)
     T = 2 * math.pi / cfg.scales.omega
     edges = [int(np.argmin(abs(t - k * T))) for k in range(round(t[-1] / T) + 1)]
     e1 = np.cross(n, [0.0, 0.0, 1.0])

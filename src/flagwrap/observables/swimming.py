@@ -79,18 +79,15 @@ def screw_progress(X: np.ndarray, R: np.ndarray, axis: np.ndarray) -> float:
     ``axis``. Over a whole period of a periodic swimmer it is the progress along the axis of
     its helical path (Purcell, Am. J. Phys. 45, 3 (1977)), whatever the window's start: a
     wobbling cell's body-axis displacement depends on the phase its window starts at. Without
-    rotation (below 1e-9 rad) the displacement along ``axis``."""
+    rotation (below 1e-9 rad) the displacement along ``axis``; the axis from scipy's rotation
+    vector (a half turn included)."""
+    from scipy.spatial.transform import Rotation
+
     d = np.asarray(X[1], float) - np.asarray(X[0], float)
-    Q = np.asarray(R[1], float) @ np.asarray(R[0], float).T
-    w = np.array([Q[2, 1] - Q[1, 2], Q[0, 2] - Q[2, 0], Q[1, 0] - Q[0, 1]])
+    w = Rotation.from_matrix(np.asarray(R[1], float) @ np.asarray(R[0], float).T).as_rotvec()
     s = np.linalg.norm(w)
-    if s < 1e-9:  # sin(angle) ~ 0: no rotation, or a half turn (axis from Q + I instead)
-        c = 0.5 * (np.trace(Q) - 1.0)
-        if c > 0:
-            return float(d @ axis)
-        B = Q + np.eye(3)
-        w = B[:, np.argmax(np.linalg.norm(B, axis=0))]
-        s = np.linalg.norm(w)
+    if s < 1e-9:
+        return float(d @ axis)
     n = w / s
     return float(d @ n) * (1.0 if n @ axis >= 0 else -1.0)
 
@@ -108,8 +105,8 @@ def phase_summary(t, phi, body_position, body_orientation, t0, t1, power=None,
     k = np.flatnonzero((t >= t0 - 1e-12 * abs(t1)) & (t <= t1 + 1e-12 * abs(t1)))
     nan = float("nan")
     if len(k) < 2:
-        return dict(speed=nan, screw_speed=nan, screw_efficiency=nan, body_rotation_hz=nan, motor_rate_hz=nan, displacement_per_turn=nan,
-                    motor_power=nan, efficiency=nan)
+        return dict(speed=nan, screw_speed=nan, screw_efficiency=nan, body_rotation_hz=nan,
+                    motor_rate_hz=nan, displacement_per_turn=nan, motor_power=nan, efficiency=nan)
     i, j = k[0], k[-1]
     R = quaternion_matrices(np.asarray(body_orientation, float)[[i, j]])
     axis = R[0][:, 2] + R[1][:, 2]
@@ -123,14 +120,15 @@ def phase_summary(t, phi, body_position, body_orientation, t0, t1, power=None,
     if power is not None:  # the time average, trapezoids over the saved frames
         pw = np.asarray(power, float)[k]
         P = float(np.sum(0.5 * (pw[1:] + pw[:-1]) * np.diff(t[k])) / dt)
-    eta = drag * (dX / dt) ** 2 / P if drag is not None and P > 0 else nan
+    def lighthill(U):
+        return drag * U ** 2 / P if drag is not None and P > 0 else nan
+
     screw = screw_progress(np.asarray(body_position)[[i, j]], R, axis) / dt
-    return dict(speed=dX / dt, screw_speed=screw,
-                screw_efficiency=drag * screw ** 2 / P if drag is not None and P > 0 else nan,
+    return dict(speed=dX / dt, screw_speed=screw, screw_efficiency=lighthill(screw),
                 body_rotation_hz=ang / dt / (2 * math.pi),
                 motor_rate_hz=dphi / dt / (2 * math.pi),
                 displacement_per_turn=dX / (abs(dphi) / (2 * math.pi)) if dphi else nan,
-                motor_power=P, efficiency=eta)
+                motor_power=P, efficiency=lighthill(dX / dt))
 
 
 def swimming_summary(ds, final_turns: float = 1.0) -> list[dict]:

@@ -71,13 +71,19 @@ def body_centre(config) -> np.ndarray:
     return cell_body_blobs(config)[0].mean(axis=0) * config.filament.length
 
 
-def _centres_and_window(ds, cfg, final_turns: float):
-    """``(R, c, d, dt)``: body rotations and lab centres (time, 3) [m], and the centre's
-    displacement over the last ``final_turns`` reference turns and its duration [s]."""
+def body_centres(ds, cfg) -> tuple[np.ndarray, np.ndarray]:
+    """``(R, c)``: a free body's rotations (time, 3, 3) and lab centres (time, 3) [m] from
+    its run file."""
     from flagwrap.observables.swimming import quaternion_matrices
 
     R = quaternion_matrices(ds["body_orientation"].values)
-    c = ds["body_position"].values + R @ body_centre(cfg)  # (time, 3) lab centres
+    return R, ds["body_position"].values + R @ body_centre(cfg)
+
+
+def _centres_and_window(ds, cfg, final_turns: float):
+    """``(R, c, d, dt)``: body rotations and lab centres (time, 3) [m], and the centre's
+    displacement over the last ``final_turns`` reference turns and its duration [s]."""
+    R, c = body_centres(ds, cfg)
     t = ds["time"].values
     T = 1.0 / cfg.scales.omega
     t1 = float(t[-1])
