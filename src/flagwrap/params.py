@@ -33,9 +33,11 @@ HYDRODYNAMIC_MODELS = ("spheres", "tube")
 #: the cell body is wider than the filament and not absurdly larger than it:
 #: 2 a < R_cell <= 10 L
 MAX_BODY_OVER_LENGTH = 10.0
-#: most blobs on a no-slip body for the direct (dense Cholesky) solve: 4000 blobs are a
-#: 12000^2 matrix, 1.15 GB, factorised once in ~10 s on one core
-MAX_BLOBS = 4000
+#: most blobs for the direct (dense Cholesky) solve, asked for by ``body.solver = "direct"``
+#: (``"auto"`` takes it up to 4000, ``body.solver.AUTO_DIRECT_MAX``) or a free cell's tube:
+#: 10000 blobs are a 30000^2 factor, 7.2 GB (priced by the memory check before any work),
+#: factorised once in minutes on one core
+MAX_BLOBS = 10000
 #: most blobs for the Krylov solve (O(n) memory, O(n^2) time per product: 20000 blobs are
 #: ~4e8 pair terms per product, seconds)
 MAX_BLOBS_KRYLOV = 20000

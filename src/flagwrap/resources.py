@@ -106,8 +106,11 @@ def _blob_cost(config, ny: int) -> tuple[int, float]:
 
     b = config.body
     direct = b.solver == "direct" or (b.solver == "auto" and n <= AUTO_DIRECT_MAX)
-    if direct:
-        return n, 2.0 * 8.0 * (3 * n) ** 2 + 8.0 * 3 * n * ny
+    if direct:  # the factor, and up to INVERSE_MAX blobs the inverse (DirectBlobSolver)
+        from flagwrap.body.solver import DirectBlobSolver
+
+        mats = 2.0 if n <= DirectBlobSolver.INVERSE_MAX else 1.0
+        return n, mats * 8.0 * (3 * n) ** 2 + 8.0 * 3 * n * ny
     # Krylov (body.solver.KrylovBlobSolver): CG vectors, the overlapping blocks' factors
     # (about 2.5 x 64 blobs each, n / 64 of them) and the coarse space's A Z (9 n^2 / 64)
     return n, 200.0 * 8.0 * 3 * n + 8.0 * (3 * 160) ** 2 * n / 64 + 8.0 * 9 * n * n / 64

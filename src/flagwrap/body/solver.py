@@ -30,8 +30,9 @@ from scipy.linalg.blas import dsymv as _symv
 from flagwrap.hydrodynamics.polydisperse import PolydisperseRPY, _pair, rpy_apply_radii
 from flagwrap.hydrodynamics.wall import wall_correction_apply, wall_correction_matrix
 
-#: most blobs for which "auto" takes the direct solver: params.MAX_BLOBS, the direct solve's
-#: own limit (a 4000-blob factor is 1.15 GB, ~2.2 GB at its peak). Below it the factor is
+#: most blobs for which "auto" takes the direct solver (a 4000-blob factor is 1.15 GB; above
+#: it the memory grows as n^2, and ``body.solver = "direct"`` asks for it up to
+#: params.MAX_BLOBS, where the Krylov solver's is O(n)). Below it the factor is
 #: the faster for every fixed set of blobs: a held S. putrefaciens body in a tube (1592
 #: blobs) factorises in 1.2 s and solves in 20 ms, where block-Jacobi CG takes 115-192
 #: iterations and 3-4 s a solve (docs/confinement.md, "Cost")
@@ -45,9 +46,10 @@ class DirectBlobSolver:
     With the inverse a solve is one matrix-vector product: one pass over the n^2 numbers where
     the two triangular solves make two slower ones (344 blobs: 0.11 ms against 0.48 ms on one
     core; 1592 blobs of a held body in a tube: 5.3 ms against 20.1 ms, for 2.2 s more to
-    build). Above ``INVERSE_MAX`` blobs the inverse's memory (and its temporaries: a 3875-blob
-    body peaks at 5.5 GB with it, 2.2 GB without) outweighs that, and the factor alone
-    solves; at 2500 blobs the inverse is 0.45 GB."""
+    build). Above ``INVERSE_MAX`` blobs the inverse's memory outweighs that, and the factor
+    alone solves; at 2500 blobs the inverse is 0.45 GB. The factor overwrites the matrix and
+    the inverse is mirrored in place: the peak is one ``(3n)^2`` matrix, two with the
+    inverse (measured: 1.11 GB at 3875 blobs, whose matrix is 1.03 GB)."""
 
     kind = "direct"
     INVERSE_MAX = 2500
@@ -61,7 +63,9 @@ class DirectBlobSolver:
             Mbb += wall_correction_matrix(wall, blobs, radii)
         if extra is not None:  # any other boundary's Delta (flagwrap.body.boundaries)
             Mbb += extra
-        L, info = lapack.dpotrf(Mbb, lower=1, overwrite_a=1)
+        # in place: the C-ordered symmetric matrix's transpose is itself, Fortran-ordered,
+        # which LAPACK takes without a copy (one (3n)^2 matrix at the peak, not two)
+        L, info = lapack.dpotrf(Mbb.T, lower=1, overwrite_a=1)
         if info != 0:
             raise ValueError(f"the blob matrix is not positive definite (LAPACK info {info})")
         self._L = L  # its upper triangle is never read (lower=True everywhere)
@@ -70,8 +74,7 @@ class DirectBlobSolver:
             inv, info = lapack.dpotri(L, lower=1, overwrite_c=0)
             if info != 0:
                 raise ValueError(f"the blob matrix could not be inverted (LAPACK info {info})")
-            inv -= np.triu(inv, 1)  # potri fills the lower triangle; the rest is Mbb's
-            inv += np.tril(inv, -1).T
+            _mirror_lower(inv)  # potri fills the lower triangle; the rest is Mbb's
             self._inv = inv
             # the same symmetric matrix in Fortran order, which BLAS takes without a copy
             self._inv_f = inv if inv.flags.f_contiguous else inv.T
@@ -90,6 +93,16 @@ class DirectBlobSolver:
         ``C (M_bb^-1 C^T)`` for many columns."""
         Y = sla.solve_triangular(self._L, C.T, lower=True, check_finite=False)
         return Y.T @ Y
+
+
+@nb.njit(cache=True)
+def _mirror_lower(a):
+    """Copy the lower triangle of the square ``a`` onto its upper one, in place (numpy's
+    ``triu``/``tril`` would make two more matrices of its size)."""
+    n = a.shape[0]
+    for j in range(n):
+        for i in range(j + 1, n):
+            a[j, i] = a[i, j]
 
 
 @nb.njit(cache=True)
