@@ -382,19 +382,33 @@ class SwimmerSystem(RodSystem):
             A[:n3, :n3] -= screening_matrix(solver, Ct)
         idx = np.arange(n3, n3 + s.ne)
         A[idx, idx] = s.twist_mobility * s.machin
-        D = np.zeros((6, self.n_in))
-        # - S: the beads' rigid-motion matrix transposed, [I; [x]_x] per bead; [0; t] per bond
-        CK = C @ MinvK
-        if view is not None:  # (M_fb + Delta_fb) M~_bb^-1 K
-            CK += view.apply(xf, s.radius, [(self.blobs, self.blob_radii, MinvK)])
-        D[:, :n3] = CK.T - geometric_matrix(xf).T
-        D[3:, n3:n3 + s.ne] -= t.T
+        D = self._rigid_rows(xf, t, C, MinvK, view)
         ND = N @ D
         A += np.matmul(D.T, ND, out=tmp)
         A /= s.machin
         if reuse:  # the body's velocity per generalized force: V = (N D / machin) G
             self._body_rows = ND / s.machin
         return A
+
+    def _rigid_rows(self, xf, t, C, MinvK, view) -> np.ndarray:
+        """``D = E - S`` (6, n_in): ``-S`` the beads' rigid-motion matrix transposed, ``[I;
+        [x]_x]`` per bead and ``[0; t]`` per bond, ``E = K^T M_bb^-1 M_bf`` the body's
+        screening of them (with the boundary's part, ``view``, where there is one)."""
+        n3 = 3 * self.nb
+        D = np.zeros((6, self.n_in))
+        CK = C @ MinvK
+        if view is not None:  # (M_fb + Delta_fb) M~_bb^-1 K
+            CK += view.apply(xf, self.radius, [(self.blobs, self.blob_radii, MinvK)])
+        D[:, :n3] = CK.T - geometric_matrix(xf).T
+        D[3:, n3:n3 + self.ne] -= t.T
+        return D
+
+    def rigid_rows(self, y) -> tuple[np.ndarray, np.ndarray]:
+        """``(D, N)`` at ``y``: the rows through which generalized forces move the body,
+        ``V = N D G / machin`` (:meth:`mobility_matrix`), and the body's 6 x 6 mobility."""
+        xf, t, C = self._geometry(y)
+        _, MinvK, N, view = self._body(y)
+        return self._rigid_rows(xf, t, C, MinvK, view), N
 
     def frame_rows(self, WT, y) -> None:
         """What a moving frame adds to ``W^T`` (written in place) once the torque motor's row
@@ -574,10 +588,17 @@ class SwimmerKrylovW(KrylovW):
     ``gamma h P J u`` being that product's pose rates.
 
     Preconditioner: each filament's own dense ``I - gamma h M_k J_kk``, ``M_k`` the
-    free-space RPY among its free beads and its twists' local drag (no body, no other
-    filament): ``n_f`` LUs of one filament's size instead of one of them all, so the cost per
-    step grows as the products do. The iterations carry what it leaves out (the body's
-    screening and motion, the filaments' mutual flow). Speed motors only (a torque motor's
+    free-space RPY among its free beads and its twists' local drag (no other filament), and
+    the body's rigid motion under every filament's forces, ``D^T N D`` (rank 6, ``D`` the
+    beads' rigid-motion rows with the body's screening of them, ``N`` the body's 6 x 6
+    mobility: :meth:`SwimmerSystem.mobility_matrix`), by the Sherman-Morrison-Woodbury
+    formula: ``n_f`` LUs of one filament's size and a 6 x 6 one, so the cost per step grows
+    as the products do. The iterations carry what it leaves out (the body's screening of
+    each filament, the filaments' mutual flow). The rank-6 term is what couples the
+    filaments most: measured (``studies/bundle_preconditioner.py``, P. putida, 40 steps from
+    rest) it takes the GCR iterations per step from 10.0 / 10.0 / 12.3 to 6.2 / 7.0 / 10.0
+    for 1 / 3 / 8 flagella, where the filaments' whole mutual free-space flow in one dense
+    block instead takes them to 10.0 / 10.1 / 11.0 only. Speed motors only (a torque motor's
     row couples the whole ``W``: refused by ``numerics.linear_solver`` before any work).
     """
 
@@ -594,6 +615,7 @@ class SwimmerKrylovW(KrylovW):
         x_free = x[system.free_beads]
         mt = np.broadcast_to(system.twist_mobility, (system.ne,))
         blocks = []
+        phi = np.arange(n)[system.sl_phi]
         for p in system.parts:
             idx = np.arange(p.ny) if p.ymap is None else p.ymap
             pos, tw = idx[:3 * p.nb], idx[3 * p.nb:3 * p.nb + p.ne]
@@ -603,9 +625,16 @@ class SwimmerKrylovW(KrylovW):
             M[:len(pos), :len(pos)] = system.mobility.matrix(xf) / system.machin
             k = np.arange(len(pos), len(I))
             M[k, k] = mt[tw - system.sl_th.start]
-            W = np.eye(len(I)) - gamma_h * (M @ self.J[I][:, I].toarray())
-            blocks.append((I, sla.lu_factor(W, check_finite=False)))
-        self.P = _FilamentBlocks(blocks)
+            JI = self.J[I]
+            W = np.eye(len(I)) - gamma_h * (M @ JI[:, I].toarray())
+            # the motor angles' rows are the identity's; their columns (the clamps turn with
+            # them) enter each block's right-hand side: W is block lower triangular
+            blocks.append((I, sla.lu_factor(W, check_finite=False),
+                           gamma_h * (M @ JI[:, phi].toarray())))
+        D, N = system.rigid_rows(y)
+        # W_P = W_blocks - U V, U = gamma h D^T N / machin (n, 6), V = D J (6, n)
+        self.P = _FilamentBlocks(blocks, gamma_h * (D.T @ N) / system.machin,
+                                 np.asarray((self.J.T @ D.T).T), phi)
 
     def _product(self, v):
         """``A (J v)`` over the whole state (filaments and pose rows)."""
@@ -626,15 +655,30 @@ class SwimmerKrylovW(KrylovW):
 
 class _FilamentBlocks:
     """:class:`SwimmerKrylovW`'s preconditioner: each filament's LU on its own unknowns, the
-    identity on the motor angles."""
+    identity on the motor angles (``phi``), whose columns ``G`` of a block move its
+    right-hand side; with ``U`` (n, k) and ``V`` (k, n), the inverse of
+    ``B - U V`` (``B`` the blocks) by the Sherman-Morrison-Woodbury formula,
+    ``B^-1 + B^-1 U (I - V B^-1 U)^-1 V B^-1``: ``k`` block solves once, a k x k LU."""
 
-    def __init__(self, blocks):
-        self.blocks = blocks
+    def __init__(self, blocks, U=None, V=None, phi=None):
+        self.blocks, self.phi = blocks, phi
+        self.BU = self.V = None
+        if U is not None:
+            self.BU = self._blocks(U)
+            self.V = V
+            self.cap = sla.lu_factor(np.eye(U.shape[1]) - V @ self.BU, check_finite=False)
+
+    def _blocks(self, r):
+        z = np.array(r, float)
+        for I, lu, G in self.blocks:
+            rI = r[I] if G is None else r[I] + G @ r[self.phi]
+            z[I] = sla.lu_solve(lu, rI, check_finite=False)
+        return z
 
     def solve(self, r):
-        z = np.array(r, float)
-        for I, lu in self.blocks:
-            z[I] = sla.lu_solve(lu, r[I], check_finite=False)
+        z = self._blocks(r)
+        if self.BU is not None:
+            z += self.BU @ sla.lu_solve(self.cap, self.V @ z, check_finite=False)
         return z
 
 
@@ -719,6 +763,26 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
         if rows is not None:
             rows[:, self.i_phi] = 0.0  # no force depends on the motor angle here
         return rows
+
+    def _rigid_rows(self, xf, t, C, MinvK, view) -> np.ndarray:
+        """``D = E - S`` (6, n_in): ``-S`` the beads' rigid-motion matrix transposed, ``[I;
+        [x]_x]`` per bead and ``[0; t]`` per bond, ``E = K^T M_bb^-1 M_bf`` the body's
+        screening of them (with the boundary's part, ``view``, where there is one)."""
+        n3 = 3 * self.nb
+        D = np.zeros((6, self.n_in))
+        CK = C @ MinvK
+        if view is not None:  # (M_fb + Delta_fb) M~_bb^-1 K
+            CK += view.apply(xf, self.radius, [(self.blobs, self.blob_radii, MinvK)])
+        D[:, :n3] = CK.T - geometric_matrix(xf).T
+        D[3:, n3:n3 + self.ne] -= t.T
+        return D
+
+    def rigid_rows(self, y) -> tuple[np.ndarray, np.ndarray]:
+        """``(D, N)`` at ``y``: the rows through which generalized forces move the body,
+        ``V = N D G / machin`` (:meth:`mobility_matrix`), and the body's 6 x 6 mobility."""
+        xf, t, C = self._geometry(y)
+        _, MinvK, N, view = self._body(y)
+        return self._rigid_rows(xf, t, C, MinvK, view), N
 
     def frame_rows(self, WT, y) -> None:
         """A torque motor's rate ``w(y)`` turns this frame, so every bead's and bond's rate
