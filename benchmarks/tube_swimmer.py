@@ -1,7 +1,9 @@
-"""The free S. putrefaciens cell swimming in a tube against free space, and the tube's two
-blob solves against each other (docs/confinement.md, "A free cell in a tube": cost).
+"""The free S. putrefaciens cell swimming in a tube (or beside a wall) against free space,
+and the boundary's two blob solves against each other (docs/confinement.md, "A free cell in
+a tube": cost).
 
-Run: ``python benchmarks/tube_swimmer.py [--turns 0.3] [--radius 1.5] [--spacing 0.375]``
+Run: ``python benchmarks/tube_swimmer.py [--turns 0.3] [--radius 1.5] [--spacing 0.375]
+[--wall X]``
 
 From the extended swimming state (``examples/s_putrefaciens_wrap.toml``'s 4 CCW turns, in
 the motor's frame, one core), ``--turns`` more CCW reference turns:
@@ -12,6 +14,9 @@ the motor's frame, one core), ``--turns`` more CCW reference turns:
    conjugate gradients from a reference factor (the default, ``refresh_iterations = 6``);
 3. the same with ``refresh_iterations = 0``: the body's blob matrix built and factorised
    exactly at every pose.
+
+With ``--wall X`` a no-slip plane ``x = -X`` um (normal +x, parallel to the cell's axis)
+takes the tube's place in 2 and 3.
 
 Prints steps, rejected steps, seconds, the factors built and the CG iterations, the ratios to
 free space, and how far the two tube runs' body positions and free ends end apart (the CG
@@ -30,17 +35,19 @@ from threadpoolctl import threadpool_limits
 
 from flagwrap.cases import case_files
 from flagwrap.io.config import load_config
-from flagwrap.params import Phase, TubeWall
+from flagwrap.params import Phase, TubeWall, Wall
 from flagwrap.simulation import Simulation
 
 
-def config(protocol, radius=None, spacing=None):
+def config(protocol, radius=None, spacing=None, wall=None):
     cfg = load_config(case_files()["s_putrefaciens_wrap"])
     cfg = cfg.replace(motor=dataclasses.replace(cfg.motor, protocol=protocol),
                       numerics=dataclasses.replace(cfg.numerics, frame="rotating"))
+    um = 1e-6
+    if wall is not None:
+        return cfg.replace(walls=(Wall(point=(-wall * um, 0.0, 0.0), normal=(1.0, 0.0, 0.0)),))
     if radius is None:
         return cfg
-    um = 1e-6
     return cfg.replace(tubes=(TubeWall(radius=radius * um, length=10 * um,
                                        center=(0.0, 0.0, -0.2 * um), axis=(0.0, 0.0, 1.0),
                                        blob_spacing=spacing * um),))
@@ -64,19 +71,24 @@ def main(argv=None):
     p.add_argument("--turns", type=float, default=0.3)
     p.add_argument("--radius", type=float, default=1.5)
     p.add_argument("--spacing", type=float, default=0.375)
+    p.add_argument("--wall", type=float, default=None,
+                   help="a wall x = -X um instead of the tube")
     args = p.parse_args(argv)
+    where = "tube" if args.wall is None else "wall"
     with threadpool_limits(limits=1):
         tr = Simulation(config((Phase("ccw", 4.0),))).run()
         y0, base = tr.final_y, tr.final_frames
         cfg_free = config((Phase("ccw", args.turns),))
-        cfg_tube = config((Phase("ccw", args.turns),), args.radius, args.spacing)
+        cfg_tube = config((Phase("ccw", args.turns),), args.radius, args.spacing, args.wall)
         run(cfg_tube, y0, base, 0.002)  # load the kernels
         rows = [("free space", *run(cfg_free, y0, base, args.turns)),
-                ("tube, CG from a reference factor", *run(cfg_tube, y0, base, args.turns)),
-                ("tube, exact factor per pose", *run(cfg_tube, y0, base, args.turns, 0))]
-    n_blobs = len(rows[1][3].blobs)
-    print(f"{args.turns:g} reference turns, tube radius {args.radius:g} um, {n_blobs} blobs "
-          f"{args.spacing:g} um apart")
+                (f"{where}, CG from a reference factor", *run(cfg_tube, y0, base, args.turns)),
+                (f"{where}, exact factor per pose", *run(cfg_tube, y0, base, args.turns, 0))]
+    if args.wall is None:
+        print(f"{args.turns:g} reference turns, tube radius {args.radius:g} um, "
+              f"{len(rows[1][3].blobs)} blobs {args.spacing:g} um apart")
+    else:
+        print(f"{args.turns:g} reference turns, wall x = -{args.wall:g} um")
     f_steps, f_time = rows[0][1].n_steps, rows[0][2]
     print("| run | steps (rejected) | s | factors | CG iterations | steps / free | time / free |")
     print("|---|---:|---:|---:|---:|---:|---:|")
@@ -88,7 +100,7 @@ def main(argv=None):
     a, b = rows[1][1], rows[2][1]
     body = np.abs(np.asarray(a.body[-1])[:3] - np.asarray(b.body[-1])[:3]).max()
     tip = np.abs(np.asarray(a.x[-1])[-1] - np.asarray(b.x[-1])[-1]).max()
-    print(f"the two tube runs end apart by: body {body:.1e} L, free end {tip:.1e} L")
+    print(f"the two {where} runs end apart by: body {body:.1e} L, free end {tip:.1e} L")
 
 
 if __name__ == "__main__":

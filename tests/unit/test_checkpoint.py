@@ -259,17 +259,22 @@ def test_resume_is_bit_identical_for_a_free_cell_with_two_torque_speed_flagella(
     assert "motors" in A and A["motors"].shape[1] == 4 and "body" in A
 
 
-def test_resume_is_bit_identical_for_a_free_cell_in_a_tube(tmp_path):
-    """In a tube the body's blob solve starts from a factor at a reference pose
-    (flagwrap.body.boundaries.TubeFromBody): the checkpoint holds that pose with the lagged
+@pytest.mark.parametrize("boundary", [
+    "[[tube]]\nradius = 0.07\nlength = 0.7\ncenter = [0.0, 0.0, -0.1]\nblob_spacing = 0.05\n",
+    "[[wall]]\npoint = [0.08, 0.0, 0.0]\nnormal = [-1.0, 0.0, 0.0]\n",
+], ids=["tube", "wall"])
+def test_resume_is_bit_identical_for_a_free_cell_beside_a_boundary(tmp_path, boundary):
+    """Beside a tube or a wall the body's blob solve starts from a factor at a reference pose
+    (flagwrap.body.boundaries.ReferenceFactor): the checkpoint holds that pose with the lagged
     screening, so the resumed run solves as the uninterrupted one. The checkpoint's
     reference is not the start's: the factor was rebuilt as the body moved."""
     text = tiny_toml(ccw=0.1, cw=0.1)
     cfg = config_from_dict(tomllib.loads(
         text + "\n[body]\nsurface = 'no-slip'\nmotion = 'free'\nblob_spacing = 0.025\n"
-        "[[tube]]\nradius = 0.07\nlength = 0.7\ncenter = [0.0, 0.0, -0.1]\n"
-        "blob_spacing = 0.05\n"))
+        + boundary))
     assert "body" in _assert_resume_identical(cfg, tmp_path)
     mem = read_checkpoint(tmp_path / "k.h5").solver_memory
-    assert mem[-1] == 7 and np.isclose(np.linalg.norm(mem[-5:-1]), 1.0)  # [X, q], its length
+    # [X, q], its length; the state's quaternion is used normalised and drifts from unit
+    # length by the step's error (measured 1.3e-5 beside the wall)
+    assert mem[-1] == 7 and abs(np.linalg.norm(mem[-5:-1]) - 1.0) < 1e-3
     assert np.any(mem[-8:-5] != 0.0)

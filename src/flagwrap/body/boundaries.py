@@ -63,6 +63,59 @@ def _cross_lab(x, radii, blobs, blob_radii) -> np.ndarray:
     return out
 
 
+class ReferenceFactor:
+    """What a boundary seen from a free body shares for the body's blob solve (module
+    docstring): the body's blob matrix ``M_bb + Delta_bb(pose)`` changes with every pose, and
+    building and factorising it exactly at each costs ``O(n_b^3)`` and ``Delta_bb``'s build.
+    Conjugate gradients on it, applied matrix-free (``M_bb`` kept, ``Delta`` applied by the
+    view), preconditioned by its Cholesky factor at a *reference* pose, converge in a few
+    iterations while the body has moved little against the boundary; when a solve needs more
+    than ``refresh_iterations``, the factor is rebuilt exactly at that pose, which becomes the
+    reference (and that solve is the factor's own, exact). The reference pose is what the
+    solver carries from step to step (:meth:`memory`: a checkpoint keeps it, so a resumed run
+    is the uninterrupted one). :class:`ScreenedBlobSolver` is the solve at one pose."""
+
+    #: a solve that needs more conjugate-gradient iterations than this rebuilds the factor
+    refresh_iterations = 6
+    #: conjugate gradients stop at this residual relative to the right-hand side's
+    rtol = 1e-11
+
+    def _reference_setup(self) -> None:
+        self.body_blobs = None  # the body's blob array (the object the swimmer passes)
+        self._Mbb = None
+        self._ref = None  # (pose key (7,), Cholesky factor of M_bb + Delta_bb there)
+        self.refreshed = 0  # how many factors were built (benchmarks)
+        self.iterations = 0  # conjugate-gradient iterations in all (benchmarks)
+
+    def blob_solver(self, view, blobs, radii, key):
+        """The body's blob solve at ``view``'s pose (``key``: the pose's 7 numbers)."""
+        if self.body_blobs is None:
+            self.body_blobs = blobs
+            self._Mbb = PolydisperseRPY(radii).matrix(blobs)
+        return ScreenedBlobSolver(self, view, blobs, radii, np.array(key, float))
+
+    def _factor(self, view, blobs, radii, key) -> None:
+        M = self._Mbb + view.correction_matrix(blobs, radii, blobs, radii)
+        self._ref = (np.array(key, float), sla.cho_factor(M, lower=True, check_finite=False))
+        self.refreshed += 1
+
+    def memory(self) -> np.ndarray:
+        """The reference pose (7,), or empty before the first factor."""
+        return np.zeros(0) if self._ref is None else self._ref[0].copy()
+
+    def restore(self, memory, blobs, radii) -> None:
+        """Continue from :meth:`memory`: the factor rebuilt at that pose (the same numbers)."""
+        memory = np.asarray(memory, float)
+        self._ref = None
+        if memory.size:
+            from flagwrap.geometry.frames import quaternion_matrix
+
+            self.blob_solver(None, blobs, radii, memory)  # the body's blobs and M_bb
+            q = memory[3:] / np.linalg.norm(memory[3:])
+            self._factor(self.at(memory[:3], quaternion_matrix(q)), blobs, radii, memory)
+
+
+
 class WallView:
     """The plane at one pose, in body coordinates."""
 
@@ -86,31 +139,21 @@ class WallView:
         return _apply_columns(self.correction_apply, xt, at, sources)
 
 
-class WallFromBody:
-    """A plane wall (lab frame, core units) as a free body sees it (module docstring). Its
-    part of the body's blob matrix is built and factorised exactly at every pose (``9 n_b^2``
-    numbers, ~0.1 s at 470 blobs)."""
+class WallFromBody(ReferenceFactor):
+    """A plane wall (lab frame, core units) as a free body sees it (module docstring). The
+    body's blob solve is :class:`ReferenceFactor`'s: a conjugate-gradient product applies the
+    wall's correction among the body's blobs (``O(n_b^2)`` per column) where an exact solve
+    at every pose builds it and factorises ``M_bb + Delta_bb`` (``O(n_b^3)``)."""
 
     kind = "wall"
 
     def __init__(self, wall: PlaneWall):
         self.wall = wall
         self.lab_geometry = wall
+        self._reference_setup()
 
     def at(self, X, R) -> WallView:
         return WallView(self.wall, X, R)
-
-    def blob_solver(self, view, blobs, radii, key=None):
-        from flagwrap.body.solver import DirectBlobSolver
-
-        return DirectBlobSolver(blobs, radii, invert=False,
-                                extra=view.correction_matrix(blobs, radii, blobs, radii))
-
-    def memory(self) -> np.ndarray:
-        return np.zeros(0)
-
-    def restore(self, memory, blobs, radii) -> None:
-        pass
 
 
 def _apply_columns(one, xt, at, sources) -> np.ndarray:
@@ -209,27 +252,17 @@ def _gram(Z) -> np.ndarray:
     return np.triu(G) + np.triu(G, 1).T
 
 
-class TubeFromBody:
+class TubeFromBody(ReferenceFactor):
     """A tube (:class:`flagwrap.confinement.tube.Tube`, core units) of no-slip ``blobs`` held
     still in the lab, as a free body sees it (module docstring). ``M_TT`` is factorised here,
     once (:class:`~flagwrap.body.solver.DirectBlobSolver`).
 
-    **The body's blob solve** (:meth:`blob_solver`, :class:`ScreenedBlobSolver`): the body's
-    blob matrix ``M_bb + Delta_bb(pose)`` changes with every pose, and building it exactly
+    **The body's blob solve** (:class:`ReferenceFactor`): building ``Delta_bb`` exactly
     costs ``27 T^2 n_b`` operations (0.2-0.6 s for the S. putrefaciens body in a tube of
-    600-1100 blobs, several poses a step). Conjugate gradients on it, applied matrix-free
-    (two cross blocks and one solve with ``M_TT`` per product), preconditioned by its
-    Cholesky factor at a *reference* pose, converge in a few iterations while the body has
-    moved little against the tube; when a solve needs more than ``refresh_iterations``, the
-    factor is rebuilt exactly at that pose, which becomes the reference (and that solve is
-    the factor's own, exact). The reference pose is what the solver carries from step to step
-    (:meth:`memory`: a checkpoint keeps it, so a resumed run is the uninterrupted one)."""
+    600-1100 blobs, several poses a step); a conjugate-gradient product costs two cross
+    blocks and one solve with ``M_TT``."""
 
     kind = "tube"
-    #: a solve that needs more conjugate-gradient iterations than this rebuilds the factor
-    refresh_iterations = 6
-    #: conjugate gradients stop at this residual relative to the right-hand side's
-    rtol = 1e-11
 
     def __init__(self, tube, blobs, blob_radii):
         from flagwrap.body.solver import DirectBlobSolver
@@ -240,51 +273,19 @@ class TubeFromBody:
         self.blob_radii = np.ascontiguousarray(np.broadcast_to(blob_radii, (len(self.blobs),)),
                                                dtype=np.float64)
         self.solver = DirectBlobSolver(self.blobs, self.blob_radii)  # its factor L: Delta
-        self.body_blobs = None  # the body's blob array (the object the swimmer passes)
-        self._Mbb = None
-        self._ref = None  # (pose key (7,), Cholesky factor of M_bb + Delta_bb there)
-        self.refreshed = 0  # how many factors were built (benchmarks)
-        self.iterations = 0  # conjugate-gradient iterations in all (benchmarks)
+        self._reference_setup()
 
     def at(self, X, R) -> TubeView:
         return TubeView(self, X, R)
 
-    def blob_solver(self, view, blobs, radii, key):
-        """The body's blob solve at ``view``'s pose (``key``: the pose's 7 numbers)."""
-        if self.body_blobs is None:
-            self.body_blobs = blobs
-            self._Mbb = PolydisperseRPY(radii).matrix(blobs)
-        return ScreenedBlobSolver(self, view, blobs, radii, np.array(key, float))
-
-    def _factor(self, view, blobs, radii, key) -> None:
-        M = self._Mbb + view.correction_matrix(blobs, radii, blobs, radii)
-        self._ref = (np.array(key, float), sla.cho_factor(M, lower=True, check_finite=False))
-        self.refreshed += 1
-
-    def memory(self) -> np.ndarray:
-        """The reference pose (7,), or empty before the first factor."""
-        return np.zeros(0) if self._ref is None else self._ref[0].copy()
-
-    def restore(self, memory, blobs, radii) -> None:
-        """Continue from :meth:`memory`: the factor rebuilt at that pose (the same numbers)."""
-        memory = np.asarray(memory, float)
-        self._ref = None
-        if memory.size:
-            from flagwrap.geometry.frames import quaternion_matrix
-
-            self.blob_solver(None, blobs, radii, memory)  # the body's blobs and M_bb
-            q = memory[3:] / np.linalg.norm(memory[3:])
-            self._factor(self.at(memory[:3], quaternion_matrix(q)), blobs, radii, memory)
-
-
 class ScreenedBlobSolver:
-    """``(M_bb + Delta_bb)^-1 r`` at one pose of a body in a tube (:class:`TubeFromBody`):
+    """``(M_bb + Delta_bb)^-1 r`` at one pose of a body beside a boundary (:class:`ReferenceFactor`):
     the reference factor's own solve at the reference pose, preconditioned conjugate
     gradients elsewhere (every column at once)."""
 
     kind = "screened"
 
-    def __init__(self, owner: TubeFromBody, view, blobs, radii, key):
+    def __init__(self, owner: ReferenceFactor, view, blobs, radii, key):
         self.owner, self.view, self.blobs, self.radii, self.key = owner, view, blobs, radii, key
 
     def _matvec(self, V) -> np.ndarray:

@@ -60,6 +60,9 @@ class RosenbrockW(AdaptiveMixin, Integrator):
                     f, _ = system.rhs(Yi, base, omega)
                 except ZeroDivisionError:  # a stage so far off that a bond has zero length
                     return self.reject(h, "degenerate stage (a bond of zero length)")
+                except np.linalg.LinAlgError:  # e.g. a free body's stage pose through a wall
+                    return self.reject(h, "degenerate stage (a blob matrix not positive "
+                                          "definite)")
             rhs = f + _combine(c[i, :i], U[:i], split) / h if i else f
             try:
                 U[i] = W.solve(gh * rhs)
