@@ -11,9 +11,9 @@ the motor's frame, one core), ``--turns`` more CCW reference turns:
 1. in free space;
 2. in an open straight tube about the body's axis (radius ``--radius`` um, 10 um long, its
    middle 0.2 um below the motor, blobs ``--spacing`` um apart), the body's blob solve by
-   conjugate gradients from a reference factor (the default, ``refresh_iterations = 6``);
+   conjugate gradients from a reference factor (``refresh_iterations = 6``, a tube's default);
 3. the same with ``refresh_iterations = 0``: the body's blob matrix built and factorised
-   exactly at every pose.
+   exactly at every pose (a wall's default).
 
 With ``--wall X`` a no-slip plane ``x = -X`` um (normal +x, parallel to the cell's axis)
 takes the tube's place in 2 and 3.
@@ -82,7 +82,7 @@ def main(argv=None):
         cfg_tube = config((Phase("ccw", args.turns),), args.radius, args.spacing, args.wall)
         run(cfg_tube, y0, base, 0.002)  # load the kernels
         rows = [("free space", *run(cfg_free, y0, base, args.turns)),
-                (f"{where}, CG from a reference factor", *run(cfg_tube, y0, base, args.turns)),
+                (f"{where}, CG from a reference factor", *run(cfg_tube, y0, base, args.turns, 6)),
                 (f"{where}, exact factor per pose", *run(cfg_tube, y0, base, args.turns, 0))]
     if args.wall is None:
         print(f"{args.turns:g} reference turns, tube radius {args.radius:g} um, "
