@@ -1,7 +1,7 @@
 """What the free cell's matrix-free stage solver leaves to its iterations: GCR iterations per
 step for variants of its preconditioner (docs/bundle.md, "The stage solve's preconditioner").
 
-    python studies/bundle_preconditioner.py [--n 1 3 8] [--steps 40]
+    python studies/bundle_preconditioner.py [--n 1 3 8] [--steps 40] [--cell free|held]
 
 examples/p_putida_bundle.toml's free cell with ``n`` flagella, ``numerics.linear_solver =
 "krylov"``, ``--steps`` steps from rest (speed motor, CCW), for each variant of
@@ -13,9 +13,18 @@ examples/p_putida_bundle.toml's free cell with ``n`` flagella, ``numerics.linear
 * ``motor``: ``filaments`` with the motor angles' columns (block lower triangular);
 * ``body``: ``motor`` with the body's rigid motion (rank 6, Woodbury): flagwrap's.
 
+With ``--cell held`` the same cell held still (``body.motion = "fixed"``) on the rig's
+matrix-free path (:class:`~flagwrap.integrators.linear.KrylovW`, banded near field along
+each chain), against preconditioners built here:
+
+* ``banded``: flagwrap's (``preconditioner_width`` beads along the chain);
+* ``spatial<R>``: the RPY blocks of every pair of free beads closer than ``R`` (core units,
+  L = 1) in space, whatever filament they are on (a k-d tree), sparse LU (SuperLU);
+* ``allpairs``: every pair's free-space block, dense LU (what any near field tends to).
+
 Prints one JSON line per case: iterations per step (four stages), ms per step (one thread
-if run so), steps. The variants are the shipped class with parts of its preconditioner
-switched off here, not options of flagwrap.
+if run so), steps. The variants are the shipped classes with parts of their preconditioner
+switched off or replaced here, not options of flagwrap.
 """
 
 from __future__ import annotations
@@ -27,20 +36,130 @@ import sys
 import time
 from pathlib import Path
 
+import numba as nb
 import numpy as np
 import scipy.linalg as sla
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 VARIANTS = ("filaments", "mutual", "motor", "body")
+HELD_VARIANTS = ("banded", "spatial0.02", "spatial0.1", "spatial0.2", "spatial0.4", "allpairs")
+
+
+def _config(n: int, steps: int, motion: str):
+    from bundle_vs_equivalent import case_config
+
+    from flagwrap.io.config import load_config
+    from flagwrap.params import Phase
+
+    base = load_config(str(Path(__file__).resolve().parents[1] / "examples"
+                           / "p_putida_bundle.toml"))
+    base = base.replace(motor=dataclasses.replace(base.motor, protocol=(Phase("ccw", 1.0),)),
+                        body=dataclasses.replace(base.body, motion=motion),
+                        numerics=dataclasses.replace(base.numerics, linear_solver="krylov",
+                                                     max_steps=steps))
+    return case_config(base, f"bundle{n}" if n > 1 else "single")
+
+
+def _timed(cfg):
+    from flagwrap.simulation import Simulation, make_system
+
+    sim = Simulation(cfg, system=make_system(cfg))
+    t0 = time.perf_counter()
+    tr = sim.run()
+    return tr, time.perf_counter() - t0
+
+
+@nb.njit(cache=True)
+def _pair_blocks(x, a, pairs, out):
+    """``out[k]``: the RPY block (viscosity 1) of the pair ``pairs[k]`` of spheres of radius a."""
+    for k in range(pairs.shape[0]):
+        i, j = pairs[k, 0], pairs[k, 1]
+        d = x[i] - x[j]
+        r = np.sqrt(d @ d)
+        if r >= 2.0 * a:
+            c = 1.0 / (8.0 * np.pi * r)
+            f, g = c * (1.0 + 2.0 * a * a / (3.0 * r * r)), c * (1.0 - 2.0 * a * a / (r * r))
+        else:
+            c = 1.0 / (6.0 * np.pi * a)
+            f, g = c * (1.0 - 9.0 * r / (32.0 * a)), c * 3.0 * r / (32.0 * a)
+        u = d / r if r > 0.0 else 0.0 * d
+        for p in range(3):
+            for q in range(3):
+                out[k, p, q] = g * u[p] * u[q] + (f if p == q else 0.0)
+
+
+class SpatialW:
+    """Sparse LU of ``I - gamma h Mob_near J``, ``Mob_near`` the RPY blocks of the free beads
+    closer than ``reach`` in space with the system's own self blocks and twist drag."""
+
+    def __init__(self, system, y, gamma_h, J, reach: float):
+        import scipy.sparse as sp
+        import scipy.sparse.linalg as spla
+        from scipy.spatial import cKDTree
+
+        x = np.ascontiguousarray(system.free_positions(y), dtype=np.float64)
+        nb_, ny, ne = len(x), system.ny, system.ne
+        pairs = cKDTree(x).query_pairs(reach, output_type="ndarray").astype(np.int64)
+        B = np.empty((len(pairs), 3, 3))
+        _pair_blocks(x, system.radius, pairs, B)
+        B /= system.machin
+        Mb, mt = system.near_field_blocks(y, 0)
+        bi = np.concatenate([np.arange(nb_), pairs[:, 0], pairs[:, 1]])
+        bj = np.concatenate([np.arange(nb_), pairs[:, 1], pairs[:, 0]])
+        bv = np.concatenate([Mb[:, 0], B, B.transpose(0, 2, 1)])
+        i3, shape = np.arange(3), (len(bi), 3, 3)
+        r = np.broadcast_to(3 * bi[:, None, None] + i3[None, :, None], shape).ravel()
+        c = np.broadcast_to(3 * bj[:, None, None] + i3[None, None, :], shape).ravel()
+        tw = np.arange(3 * nb_, 3 * nb_ + ne)
+        M = sp.csr_matrix((np.concatenate([bv.ravel(), np.broadcast_to(mt, (ne,))]),
+                           (np.concatenate([r, tw]), np.concatenate([c, tw]))), shape=(ny, ny))
+        self.lu = spla.splu((sp.identity(ny, format="csc") - gamma_h * (M @ J)).tocsc())
+
+    def solve(self, rhs):
+        return self.lu.solve(np.asarray(rhs, float))
+
+
+class _Dense:
+    def __init__(self, W):
+        self.lu = sla.lu_factor(W, check_finite=False)
+
+    def solve(self, r):
+        return sla.lu_solve(self.lu, r, check_finite=False)
+
+
+def run_held(n: int, variant: str, steps: int) -> dict:
+    import flagwrap.integrators.linear as lin
+    from flagwrap.hydrodynamics.mobility import RPYMobility
+
+    made = []
+    orig = lin.KrylovW.__init__
+
+    def init(self, system, y, base, G0, gamma_h, *a, **k):
+        orig(self, system, y, base, G0, gamma_h, *a, **k)
+        made.append(self)
+        if variant.startswith("spatial"):
+            self.P = SpatialW(system, y, gamma_h, self.J, float(variant[7:]))
+        elif variant == "allpairs":
+            x = np.ascontiguousarray(system.free_positions(y))
+            n3, ny = 3 * len(x), system.ny
+            M = np.zeros((ny, ny))
+            M[:n3, :n3] = RPYMobility(system.radius).matrix(x) / system.machin
+            tw = np.arange(n3, n3 + system.ne)
+            M[tw, tw] = np.broadcast_to(system.twist_mobility, (system.ne,))
+            self.P = _Dense(np.eye(ny) - gamma_h * (M @ self.J.toarray()))
+
+    lin.KrylovW.__init__ = init
+    try:
+        tr, dt = _timed(_config(n, steps, "fixed"))
+    finally:
+        lin.KrylovW.__init__ = orig
+    its = [m.iterations for m in made]
+    return {"cell": "held", "n": n, "variant": variant, "steps": tr.n_steps,
+            "iterations": sum(its) / len(its), "ms_per_step": 1e3 * dt / tr.n_steps}
 
 
 def run(n: int, variant: str, steps: int) -> dict:
-    from bundle_vs_equivalent import case_config
-
     import flagwrap.system.swimmer as sw
-    from flagwrap.io.config import load_config
-    from flagwrap.params import Phase
-    from flagwrap.simulation import Simulation, make_system
 
     made = []
     orig = sw.SwimmerKrylovW.__init__
@@ -68,20 +187,11 @@ def run(n: int, variant: str, steps: int) -> dict:
 
     sw.SwimmerKrylovW.__init__ = init
     try:
-        base = load_config(str(Path(__file__).resolve().parents[1] / "examples"
-                               / "p_putida_bundle.toml"))
-        base = base.replace(motor=dataclasses.replace(base.motor, protocol=(Phase("ccw", 1.0),)),
-                            numerics=dataclasses.replace(base.numerics, linear_solver="krylov",
-                                                         max_steps=steps))
-        cfg = case_config(base, f"bundle{n}" if n > 1 else "single")
-        sim = Simulation(cfg, system=make_system(cfg))
-        t0 = time.perf_counter()
-        tr = sim.run()
-        dt = time.perf_counter() - t0
+        tr, dt = _timed(_config(n, steps, "free"))
     finally:
         sw.SwimmerKrylovW.__init__ = orig
     its = [m.iterations for m in made]
-    return {"n": n, "variant": variant, "steps": tr.n_steps,
+    return {"cell": "free", "n": n, "variant": variant, "steps": tr.n_steps,
             "iterations": sum(its) / len(its), "ms_per_step": 1e3 * dt / tr.n_steps}
 
 
@@ -89,12 +199,15 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--n", type=int, nargs="+", default=[1, 3, 8])
     p.add_argument("--steps", type=int, default=40)
-    p.add_argument("--variants", nargs="+", choices=VARIANTS, default=list(VARIANTS))
+    p.add_argument("--cell", choices=("free", "held"), default="free")
+    p.add_argument("--variants", nargs="+", choices=VARIANTS + HELD_VARIANTS, default=None)
     a = p.parse_args(argv)
-    run(1, "body", 3)  # compile every kernel before timing
+    fun = run if a.cell == "free" else run_held
+    variants = a.variants or (VARIANTS if a.cell == "free" else HELD_VARIANTS)
+    fun(1, variants[-1], 3)  # compile every kernel before timing
     for n in a.n:
-        for v in a.variants:
-            print(json.dumps(run(n, v, a.steps)), flush=True)
+        for v in variants:
+            print(json.dumps(fun(n, v, a.steps)), flush=True)
     return 0
 
 
