@@ -13,11 +13,13 @@ Run: ``python studies/wall_swimming.py [--modes extended wrapped] [--gaps 0.5 1 
    filament) over the free run's last turn. The wall screens the flow (Rotne-Prager-Blake)
    and repels the beads; the turning frame (exact beside any wall).
 3. From each run file, per turn: the body centre's height above the wall, its axis' tilt
-   towards the wall, and the heading, the direction in the wall's plane of the centre's
-   displacement over the turn. The circling rate is the heading's turn about the normal per
-   reference turn over the last ``--fit`` turns (a straight-line fit; + = counter-clockwise
-   seen from the fluid looking at the wall) and the circle's radius the speed along the wall
-   over that rate.
+   towards the wall, and the heading: the angle in the wall's plane of the body's axis,
+   averaged over the turn. The circling rate is the heading's turn about the normal per
+   reference turn over the last ``--fit`` turns (a least-squares line, with its standard
+   error; + = counter-clockwise seen from the fluid looking at the wall) and the circle's
+   radius the speed along the wall over that rate. (Not the direction of the centre's
+   displacement over each turn: the body's precession about its path swings that chord by
+   +-30 degrees from turn to turn, where the turn-averaged axis holds to 0.3 degrees.)
 
 Prints one row per (state, gap) and keeps each run file in ``--out``.
 """
@@ -64,9 +66,10 @@ def with_wall(cfg, x_wall):
 
 def per_turn_track(path):
     """Per reference turn (arrays over turns): the body centre's height above the wall [m],
-    its axis' tilt towards the wall [deg] (+ = pointing at the fluid), the heading angle of
-    the centre's displacement in the wall's plane [rad, unwrapped, about the normal] and the
-    speed along the wall [m/s]."""
+    its axis' tilt towards the wall [deg] (+ = pointing at the fluid), the heading, the
+    angle of the body's axis in the wall's plane averaged over the turn [rad, unwrapped,
+    about the normal], and the centre's displacement along the wall over the turn [m] (3
+    components) with the turn's duration [s]."""
     from flagwrap.io.runfile import config_of, read_run
     from flagwrap.observables.wall import body_centres
 
@@ -81,15 +84,31 @@ def per_turn_track(path):
     e1 = np.cross(n, [0.0, 0.0, 1.0])
     e1 = e1 / np.linalg.norm(e1) if np.linalg.norm(e1) > 1e-9 else np.array([0.0, 1.0, 0.0])
     e2 = np.cross(n, e1)  # (e1, e2, n) right-handed: angles + about n
-    h, tilt, heading, speed = [], [], [], []
+    axis = R[:, :, 2]  # the body's axis in the lab, per record
+    angle = np.unwrap(np.arctan2(axis @ e2, axis @ e1))
+    h, tilt, heading, disp, dt = [], [], [], [], []
     for i, j in itertools.pairwise(edges):
         d = c[j] - c[i]
-        dp = d - (d @ n) * n
+        disp.append(d - (d @ n) * n)
+        dt.append(t[j] - t[i])
         h.append(float((0.5 * (c[i] + c[j]) - p) @ n))
         tilt.append(math.degrees(math.asin(float(np.clip(R[j][:, 2] @ n, -1, 1)))))
-        heading.append(math.atan2(float(dp @ e2), float(dp @ e1)))
-        speed.append(float(np.linalg.norm(dp)) / (t[j] - t[i]))
-    return np.array(h), np.array(tilt), np.unwrap(heading), np.array(speed)
+        heading.append(float(np.mean(angle[i:j + 1])))
+    return np.array(h), np.array(tilt), np.array(heading), np.array(disp), np.array(dt)
+
+
+def circling_rate(heading) -> tuple[float, float]:
+    """``(rate, standard error)`` [rad per turn] of a least-squares line through ``heading``
+    (one value per turn); the error ``nan`` below three turns."""
+    k = np.arange(len(heading), dtype=float)
+    if len(k) < 2:
+        return math.nan, math.nan
+    rate, c0 = np.polyfit(k, heading, 1)
+    if len(k) < 3:
+        return float(rate), math.nan
+    resid = heading - (rate * k + c0)
+    se = math.sqrt(float(resid @ resid) / (len(k) - 2) / float(((k - k.mean()) ** 2).sum()))
+    return float(rate), se
 
 
 def main(argv=None):
@@ -106,7 +125,7 @@ def main(argv=None):
     found = ts.states(out)
     um = 1e-6
     print("| state | gap at start [um] | steps | s | height at start -> end [um] | tilt end "
-          "[deg] | speed along the wall [um/s] | circling [deg/turn] | circle radius [um] |")
+          "[deg] | net speed along the wall [um/s] | circling [deg/turn] | circle radius [um] |")
     print("|---|---:|---:|---:|---|---:|---:|---:|---:|")
     for mode in args.modes:
         y0, base = found[mode]
@@ -123,14 +142,16 @@ def main(argv=None):
             path = out / f"{mode}_gap{gap:g}.nc"
             start = time.perf_counter()
             tr, _ = ts.run_one(cfg, y0, base, path)
-            h, tilt, head, speed = per_turn_track(path)
+            h, tilt, head, disp, dt = per_turn_track(path)
             m = min(args.fit, len(head))
-            rate = np.polyfit(np.arange(m), head[-m:], 1)[0] if m >= 2 else math.nan
-            v = float(np.mean(speed[-m:]))
+            rate, se = circling_rate(head[-m:])
+            # net: each turn's chord swings with the body's precession about its path
+            v = float(np.linalg.norm(disp[-m:].sum(axis=0))) / float(dt[-m:].sum())
             radius = v * 2 * math.pi / cfg.scales.omega / abs(rate) if rate else math.inf
             print(f"| {mode} | {gap:g} | {tr.n_steps} | {time.perf_counter() - start:.0f} | "
                   f"{h[0] / um:.2f} -> {h[-1] / um:.2f} | {tilt[-1]:+.1f} | {v / um:.3f} | "
-                  f"{math.degrees(rate):+.3f} | {radius / um:.1f} |", flush=True)
+                  f"{math.degrees(rate):+.3f} +- {math.degrees(se):.3f} | {radius / um:.0f} |",
+                  flush=True)
             print("  height per 5 turns [um]: "
                   + " ".join(f"{x / um:.2f}" for x in h[::5]), flush=True)
 
