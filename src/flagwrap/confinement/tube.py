@@ -132,6 +132,14 @@ class Tube:
         return g, grad, rhat, r
 
     @property
+    def about_z(self) -> bool:
+        """The tube is coaxial with the z axis (the motor's): its wall, constriction and ends
+        are then unchanged by a rotation about it."""
+        a, c = self.axis, self.center
+        scale = max(self.radius, abs(c[2]), 1e-300)
+        return math.hypot(a[0], a[1]) < 1e-12 and math.hypot(c[0], c[1]) < 1e-12 * scale
+
+    @property
     def narrowest(self) -> float:
         return self.radius if self.constriction_radius is None else self.constriction_radius
 

@@ -95,6 +95,7 @@ class TubeContact(_BoundaryContact):
     def __init__(self, tube, cutoff: float, strength: float, active, c2: float = 1.0):
         super().__init__(cutoff, strength, active, c2)
         self.tube = tube
+        self.rotation_invariant = tube.about_z  # a gap to an axisymmetric wall about z
 
     def energy_grad(self, x, theta, grad_x, grad_theta) -> float:
         g, dg, _, _ = self.tube.gap_gradient(x)

@@ -258,13 +258,23 @@ def refuse_polymorph(config) -> None:
 
 
 def refuse_tube(config) -> None:
-    """A one-line :class:`UserInputError` for a ``[[tube]]``: its blobs are not symmetric
-    about the motor axis, so there is no steady whirl of the turning frame to linearise."""
-    if config.tubes:
+    """A one-line :class:`UserInputError` for a ``[[tube]]`` the turning frame cannot hold:
+    one not coaxial with the motor axis (no steady whirl to linearise), or around a free cell
+    (it swims along the tube: no steady state). A coaxial tube around the rig or a held cell
+    is linearised as a held body's blob shell is: its blobs held at one angle in the turning
+    frame (:class:`~flagwrap.system.rotating.RotatingFrame`, ``blob_body``)."""
+    if not config.tubes:
+        return
+    from flagwrap.system.parts import config_tube
+
+    if config.body.free:
         raise UserInputError(
-            "[[tube]] is not available to flagwrap stability (a tube of blobs breaks the "
-            "turning frame's symmetry about the motor axis); run it in the time domain "
-            "(flagwrap run)")
+            "flagwrap stability: a free cell in a [[tube]] has no steady whirl (it swims "
+            "along the tube); run it in the time domain (flagwrap run)")
+    if not config_tube(config).about_z:
+        raise UserInputError(
+            "flagwrap stability: tube[0] must be coaxial with the motor axis (tube.axis along "
+            "z, tube.center on it) for a steady whirl; run it in the time domain (flagwrap run)")
 
 
 def make_frame(config, omega: float):
@@ -294,8 +304,9 @@ def make_frame(config, omega: float):
         from flagwrap.system.polymorph import PolymorphFrame, PolymorphSystem
 
         return PolymorphFrame(PolymorphSystem(RodSystem(config)), omega,
-                              blob_body=config.body.no_slip)
-    return RotatingFrame(RodSystem(config), omega, blob_body=config.body.no_slip)
+                              blob_body=config.body.no_slip or bool(config.tubes))
+    blobs = config.body.no_slip or bool(config.tubes)  # a held shell of blobs either way
+    return RotatingFrame(RodSystem(config), omega, blob_body=blobs)
 
 
 def check_continuation_options(m_start, m_max, rtol, factor, option=lambda name: name) -> None:
