@@ -119,6 +119,20 @@ class SpatialW:
         return self.lu.solve(np.asarray(rhs, float))
 
 
+def _free_space_mobility(system, y, n: int) -> np.ndarray:
+    """(n, n): every pair of free beads' free-space RPY block and the twists' drag, the
+    system's state order (beads, then twists), zero elsewhere."""
+    from flagwrap.hydrodynamics.mobility import RPYMobility
+
+    x = np.ascontiguousarray(system.free_positions(y))
+    n3 = 3 * len(x)
+    M = np.zeros((n, n))
+    M[:n3, :n3] = RPYMobility(system.radius).matrix(x) / system.machin
+    tw = np.arange(n3, n3 + system.ne)
+    M[tw, tw] = np.broadcast_to(system.twist_mobility, (system.ne,))
+    return M
+
+
 class _Dense:
     def __init__(self, W):
         self.lu = sla.lu_factor(W, check_finite=False)
@@ -129,7 +143,6 @@ class _Dense:
 
 def run_held(n: int, variant: str, steps: int) -> dict:
     import flagwrap.integrators.linear as lin
-    from flagwrap.hydrodynamics.mobility import RPYMobility
 
     made = []
     orig = lin.KrylovW.__init__
@@ -140,13 +153,8 @@ def run_held(n: int, variant: str, steps: int) -> dict:
         if variant.startswith("spatial"):
             self.P = SpatialW(system, y, gamma_h, self.J, float(variant[7:]))
         elif variant == "allpairs":
-            x = np.ascontiguousarray(system.free_positions(y))
-            n3, ny = 3 * len(x), system.ny
-            M = np.zeros((ny, ny))
-            M[:n3, :n3] = RPYMobility(system.radius).matrix(x) / system.machin
-            tw = np.arange(n3, n3 + system.ne)
-            M[tw, tw] = np.broadcast_to(system.twist_mobility, (system.ne,))
-            self.P = _Dense(np.eye(ny) - gamma_h * (M @ self.J.toarray()))
+            M = _free_space_mobility(system, y, system.ny)
+            self.P = _Dense(np.eye(system.ny) - gamma_h * (M @ self.J.toarray()))
 
     lin.KrylovW.__init__ = init
     try:
@@ -174,14 +182,8 @@ def run(n: int, variant: str, steps: int) -> dict:
         if variant == "motor":
             P.BU = None
         if variant == "mutual":
-            x, _, _ = system.unpack(y)
-            xf = np.ascontiguousarray(x[system.free_beads])
-            n3 = 3 * len(xf)
             I = np.concatenate([b[0] for b in P.blocks])
-            M = np.zeros((self.n, self.n))
-            M[:n3, :n3] = system.mobility.matrix(xf) / system.machin
-            tw = np.arange(n3, n3 + system.ne)
-            M[tw, tw] = np.broadcast_to(system.twist_mobility, (system.ne,))
+            M = _free_space_mobility(system, y, self.n)
             W = np.eye(len(I)) - gamma_h * (M[np.ix_(I, I)] @ self.J[I][:, I].toarray())
             P.blocks = [(I, sla.lu_factor(W, check_finite=False), None)]
 

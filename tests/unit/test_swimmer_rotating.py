@@ -199,6 +199,16 @@ def test_krylov_stage_solver_runs_as_the_dense_one(kind):
     assert isinstance(s.make_w("krylov", y, info.frames, info.G, 0.01), SwimmerKrylovW)
 
 
+def _loaded_krylov_w(kind, rng, gh=0.05):
+    """``(system, y, info, gamma h, W)``: the matrix-free stage solver of ``kind`` at a state
+    loaded by moving its beads 0.01 bond at random."""
+    s = make_system(_kind_cfg(kind, "krylov"))
+    y = s.initial_y()
+    y[s.sl_x] += 0.01 * s.bond * rng.standard_normal(s.sl_x.stop - s.sl_x.start)
+    info = s.forces(y, s.frames0)
+    return s, y, info, gh, s.make_w("krylov", y, info.frames, info.G, gh)
+
+
 @pytest.mark.parametrize("kind", FREE_KINDS)
 def test_krylov_solve_meets_its_residual_and_the_dense_pose_rows(kind, rng):
     """One solve at a loaded state: the filaments' rows leave a relative residual of ``W``
@@ -207,12 +217,7 @@ def test_krylov_solve_meets_its_residual_and_the_dense_pose_rows(kind, rng):
     body's rows, an independent route) to 1e-10."""
     from flagwrap.system.swimmer import SwimmerW
 
-    s = make_system(_kind_cfg(kind, "krylov"))
-    y = s.initial_y()
-    y[s.sl_x] += 0.01 * s.bond * rng.standard_normal(s.sl_x.stop - s.sl_x.start)
-    info = s.forces(y, s.frames0)
-    gh = 0.05
-    W = s.make_w("krylov", y, info.frames, info.G, gh)
+    s, y, info, gh, W = _loaded_krylov_w(kind, rng)
     rhs = rng.standard_normal(s.ny)
     n = s.n_in
     rhs[s.i_phi] = 0.0
@@ -235,12 +240,7 @@ def test_krylov_preconditioner_inverts_the_filaments_and_the_body_motion(kind, r
     To 1e-9 (a dense solve of a well-conditioned system, ~1e-13 in exact rounding)."""
     from flagwrap.body.solver import screening_matrix
 
-    s = make_system(_kind_cfg(kind, "krylov"))
-    y = s.initial_y()
-    y[s.sl_x] += 0.01 * s.bond * rng.standard_normal(s.sl_x.stop - s.sl_x.start)
-    info = s.forces(y, s.frames0)
-    gh = 0.05
-    W = s.make_w("krylov", y, info.frames, info.G, gh)
+    s, y, _, gh, W = _loaded_krylov_w(kind, rng)
     n, n3 = s.n_in, 3 * s.nb
     xf, _, C = s._geometry(y)
     Mff = s.mobility.matrix(xf)

@@ -764,26 +764,6 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
             rows[:, self.i_phi] = 0.0  # no force depends on the motor angle here
         return rows
 
-    def _rigid_rows(self, xf, t, C, MinvK, view) -> np.ndarray:
-        """``D = E - S`` (6, n_in): ``-S`` the beads' rigid-motion matrix transposed, ``[I;
-        [x]_x]`` per bead and ``[0; t]`` per bond, ``E = K^T M_bb^-1 M_bf`` the body's
-        screening of them (with the boundary's part, ``view``, where there is one)."""
-        n3 = 3 * self.nb
-        D = np.zeros((6, self.n_in))
-        CK = C @ MinvK
-        if view is not None:  # (M_fb + Delta_fb) M~_bb^-1 K
-            CK += view.apply(xf, self.radius, [(self.blobs, self.blob_radii, MinvK)])
-        D[:, :n3] = CK.T - geometric_matrix(xf).T
-        D[3:, n3:n3 + self.ne] -= t.T
-        return D
-
-    def rigid_rows(self, y) -> tuple[np.ndarray, np.ndarray]:
-        """``(D, N)`` at ``y``: the rows through which generalized forces move the body,
-        ``V = N D G / machin`` (:meth:`mobility_matrix`), and the body's 6 x 6 mobility."""
-        xf, t, C = self._geometry(y)
-        _, MinvK, N, view = self._body(y)
-        return self._rigid_rows(xf, t, C, MinvK, view), N
-
     def frame_rows(self, WT, y) -> None:
         """A torque motor's rate ``w(y)`` turns this frame, so every bead's and bond's rate
         (``-w a x x''``, ``-w a . t``) follows the motor's load: ``W`` gains ``gamma h c
