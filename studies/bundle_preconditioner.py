@@ -141,41 +141,46 @@ class _Dense:
         return sla.lu_solve(self.lu, r, check_finite=False)
 
 
-def run_held(n: int, variant: str, steps: int) -> dict:
-    import flagwrap.integrators.linear as lin
-
+def _measured(cls, after, cell: str, n: int, variant: str, steps: int) -> dict:
+    """``steps`` steps of the ``cell`` ("free" or "held") with ``n`` flagella, every stage
+    solver of class ``cls`` handed to ``after(W, system, y, gamma_h)`` once built; its GCR
+    iterations per step and the time per step."""
     made = []
-    orig = lin.KrylovW.__init__
+    orig = cls.__init__
 
     def init(self, system, y, base, G0, gamma_h, *a, **k):
         orig(self, system, y, base, G0, gamma_h, *a, **k)
         made.append(self)
+        after(self, system, y, gamma_h)
+
+    cls.__init__ = init
+    try:
+        tr, dt = _timed(_config(n, steps, "free" if cell == "free" else "fixed"))
+    finally:
+        cls.__init__ = orig
+    its = [m.iterations for m in made]
+    return {"cell": cell, "n": n, "variant": variant, "steps": tr.n_steps,
+            "iterations": sum(its) / len(its), "ms_per_step": 1e3 * dt / tr.n_steps}
+
+
+def run_held(n: int, variant: str, steps: int) -> dict:
+    import flagwrap.integrators.linear as lin
+
+    def after(W, system, y, gamma_h):
         if variant.startswith("spatial"):
-            self.P = SpatialW(system, y, gamma_h, self.J, float(variant[7:]))
+            W.P = SpatialW(system, y, gamma_h, W.J, float(variant[7:]))
         elif variant == "allpairs":
             M = _free_space_mobility(system, y, system.ny)
-            self.P = _Dense(np.eye(system.ny) - gamma_h * (M @ self.J.toarray()))
+            W.P = _Dense(np.eye(system.ny) - gamma_h * (M @ W.J.toarray()))
 
-    lin.KrylovW.__init__ = init
-    try:
-        tr, dt = _timed(_config(n, steps, "fixed"))
-    finally:
-        lin.KrylovW.__init__ = orig
-    its = [m.iterations for m in made]
-    return {"cell": "held", "n": n, "variant": variant, "steps": tr.n_steps,
-            "iterations": sum(its) / len(its), "ms_per_step": 1e3 * dt / tr.n_steps}
+    return _measured(lin.KrylovW, after, "held", n, variant, steps)
 
 
 def run(n: int, variant: str, steps: int) -> dict:
     import flagwrap.system.swimmer as sw
 
-    made = []
-    orig = sw.SwimmerKrylovW.__init__
-
-    def init(self, system, y, base, G0, gamma_h, *a, **k):
-        orig(self, system, y, base, G0, gamma_h, *a, **k)
-        made.append(self)
-        P = self.P
+    def after(W, system, y, gamma_h):
+        P = W.P
         if variant in ("filaments", "mutual"):
             P.BU = None
             P.blocks = [(I, lu, None) for I, lu, _ in P.blocks]
@@ -183,18 +188,11 @@ def run(n: int, variant: str, steps: int) -> dict:
             P.BU = None
         if variant == "mutual":
             I = np.concatenate([b[0] for b in P.blocks])
-            M = _free_space_mobility(system, y, self.n)
-            W = np.eye(len(I)) - gamma_h * (M[np.ix_(I, I)] @ self.J[I][:, I].toarray())
-            P.blocks = [(I, sla.lu_factor(W, check_finite=False), None)]
+            M = _free_space_mobility(system, y, W.n)
+            WI = np.eye(len(I)) - gamma_h * (M[np.ix_(I, I)] @ W.J[I][:, I].toarray())
+            P.blocks = [(I, sla.lu_factor(WI, check_finite=False), None)]
 
-    sw.SwimmerKrylovW.__init__ = init
-    try:
-        tr, dt = _timed(_config(n, steps, "free"))
-    finally:
-        sw.SwimmerKrylovW.__init__ = orig
-    its = [m.iterations for m in made]
-    return {"cell": "free", "n": n, "variant": variant, "steps": tr.n_steps,
-            "iterations": sum(its) / len(its), "ms_per_step": 1e3 * dt / tr.n_steps}
+    return _measured(sw.SwimmerKrylovW, after, "free", n, variant, steps)
 
 
 def main(argv=None) -> int:
