@@ -40,6 +40,8 @@ import numba as nb
 import numpy as np
 import scipy.linalg as sla
 
+from flagwrap.hydrodynamics._kernels import _pair
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 VARIANTS = ("filaments", "mutual", "motor", "body")
 HELD_VARIANTS = ("banded", "spatial0.02", "spatial0.1", "spatial0.2", "spatial0.4", "allpairs")
@@ -71,17 +73,13 @@ def _timed(cfg):
 
 @nb.njit(cache=True)
 def _pair_blocks(x, a, pairs, out):
-    """``out[k]``: the RPY block (viscosity 1) of the pair ``pairs[k]`` of spheres of radius a."""
+    """``out[k]``: the RPY block (viscosity 1) of the pair ``pairs[k]`` of spheres of radius a
+    (the core's pair law, ``flagwrap.hydrodynamics._kernels._pair``)."""
     for k in range(pairs.shape[0]):
         i, j = pairs[k, 0], pairs[k, 1]
         d = x[i] - x[j]
         r = np.sqrt(d @ d)
-        if r >= 2.0 * a:
-            c = 1.0 / (8.0 * np.pi * r)
-            f, g = c * (1.0 + 2.0 * a * a / (3.0 * r * r)), c * (1.0 - 2.0 * a * a / (r * r))
-        else:
-            c = 1.0 / (6.0 * np.pi * a)
-            f, g = c * (1.0 - 9.0 * r / (32.0 * a)), c * 3.0 * r / (32.0 * a)
+        f, g = _pair(r, a)
         u = d / r if r > 0.0 else 0.0 * d
         for p in range(3):
             for q in range(3):

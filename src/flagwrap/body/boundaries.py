@@ -115,7 +115,6 @@ class ReferenceFactor:
             self._factor(self.at(memory[:3], quaternion_matrix(q)), blobs, radii, memory)
 
 
-
 class WallView:
     """The plane at one pose, in body coordinates."""
 
