@@ -124,14 +124,26 @@ class Passage:
 
 
 def run(cfg, y0, base, turns, path, stop=None, flip=False):
+    """Run ``turns`` reference periods from the state and write the run file ``path``; with a
+    ``stop`` event, checkpointed every 2 min beside it (``.ckpt.h5``) and resumed from there
+    when that file exists (the event then counts periods from the checkpoint's time)."""
+    from flagwrap.io.checkpoint import read_checkpoint
     from flagwrap.io.runfile import write_run
 
-    sim = Simulation(cfg)
+    ck = path.with_name(path.stem + ".ckpt.h5")
+    sim = Simulation(cfg, **({} if stop is None else
+                             {"checkpoint_path": ck, "checkpoint_every_seconds": 120.0}))
     y = at_origin(sim.system, y0, flip)
     start = time.perf_counter()
     try:
-        tr = sim.run(t_end=TWO_PI * turns, y0=y, base=base, t0=0.0, stop=stop)
-    except RunInterrupted as exc:  # Ctrl-C: keep what was computed, then stop
+        if stop is not None and ck.exists():
+            c = read_checkpoint(ck)
+            stop.next = math.floor(c.t / TWO_PI + 1e-9) + 1.0
+            print(f"  resumed from {ck} at t/T = {c.t / TWO_PI:.3f}", flush=True)
+            tr = sim.run(resume=c, stop=stop)
+        else:
+            tr = sim.run(t_end=TWO_PI * turns, y0=y, base=base, t0=0.0, stop=stop)
+    except RunInterrupted as exc:  # Ctrl-C or SIGTERM: keep what was computed, then stop
         write_run(exc.trajectory, path)
         raise
     wall = time.perf_counter() - start
@@ -218,11 +230,11 @@ def main(argv=None):
         z_neck = hi + args.lead + args.neck_length / 2
         back = lo - args.behind
         front = z_neck + args.neck_length / 2 + args.beyond
-        tube = TubeWall(radius=args.tube_radius * UM, length=(front - back) * UM,
-                        center=(0.0, 0.0, (front + back) / 2 * UM), axis=(0.0, 0.0, 1.0),
+        tube = TubeWall(radius=args.tube_radius * UM, length=float(front - back) * UM,
+                        center=(0.0, 0.0, float(front + back) / 2 * UM), axis=(0.0, 0.0, 1.0),
                         constriction_radius=args.neck * UM,
                         constriction_length=args.neck_length * UM,
-                        constriction_center=(z_neck - (front + back) / 2) * UM,
+                        constriction_center=float(z_neck - (front + back) / 2) * UM,
                         blob_spacing=args.spacing * UM)
         print(f"{mode}: free speed {u_free:+.2f} um/s along the body axis, envelope radius "
               f"{env:.2f} um, cell z {lo:.2f} to {hi:.2f} um; neck's middle at {z_neck:+.2f} um, "

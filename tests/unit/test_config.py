@@ -79,3 +79,26 @@ def test_stored_toml_escapes_control_characters(tmp_path):
     p = tmp_path / "c.toml"
     p.write_text(config_to_toml(cfg))
     assert load_config(p).name == cfg.name
+
+
+def test_stored_toml_reads_back_numpy_scalars(tmp_path):
+    # configs built in Python take numpy scalars (a study's tube length from array arithmetic);
+    # numpy 2 prints them as "np.float64(...)", which no TOML reader takes
+    import dataclasses
+
+    import numpy as np
+
+    from flagwrap.params import TubeWall
+
+    cfg = config_from_dict(_BASE)
+    tube = TubeWall(radius=np.float64(0.5), length=np.float64(0.4), center=(0.0, 0.0, -0.2),
+                    blob_spacing=np.float64(0.05))
+    cfg = cfg.replace(tubes=(tube,), fluid=dataclasses.replace(cfg.fluid,
+                                                                viscosity=np.float64(1.5)))
+    text = config_to_toml(cfg)
+    assert "np." not in text
+    p = tmp_path / "c.toml"
+    p.write_text(text)
+    again = load_config(p)
+    assert again.tubes[0].length == 0.4 and again.fluid.viscosity == 1.5
+    assert again.to_dict() == {**cfg.to_dict(), "name": again.name}
