@@ -55,27 +55,13 @@ def base_config(protocol):
 
 
 def states(out: Path):
-    """``{"extended": (y, frames), "wrapped": (y, frames)}`` in the motor's frame."""
-    from flagwrap.elasticity.rod import Frames
+    """``{"extended": (y, frames), "wrapped": (y, frames)}`` in the motor's frame (kept in
+    ``out/states.npz``)."""
+    from tube_swimming import states as swimming_states
 
-    cache = out / "states.npz"
-    if cache.exists():
-        z = np.load(cache)
-        return {n: (z[f"{n}_y"], Frames(z[f"{n}_t"], z[f"{n}_d1"], z[f"{n}_rt"]))
-                for n in ("extended", "wrapped")}
-    found, keep = {}, {}
-    for name, protocol in (("extended", (Phase("ccw", 3.0),)),
-                           ("wrapped", (Phase("ccw", 3.0), Phase("cw", 12.0)))):
-        start = time.perf_counter()
-        tr = Simulation(base_config(protocol)).run()
-        print(f"{name} state: {tr.status}, {tr.n_steps} steps, "
-              f"{time.perf_counter() - start:.0f} s", flush=True)
-        fr = tr.final_frames
-        found[name] = (tr.final_y, fr)
-        keep.update({f"{name}_y": tr.final_y, f"{name}_t": fr.t, f"{name}_d1": fr.d1,
-                     f"{name}_rt": fr.rt})
-    np.savez(cache, **keep)
-    return found
+    return swimming_states(out, base_config,
+                           {"extended": (Phase("ccw", 3.0),),
+                            "wrapped": (Phase("ccw", 3.0), Phase("cw", 12.0))})
 
 
 def at_origin(system, y, flip=False):

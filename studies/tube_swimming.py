@@ -59,21 +59,25 @@ def with_tube(cfg, radius_um, length_um, centre_um, spacing_um):
     return cfg.replace(tubes=(tube,))
 
 
-def states(out: Path):
+def states(out: Path, make_config=None, protocols=None):
     """``{"extended": (y, frames), "wrapped": (y, frames)}`` in the motor's frame (kept in
-    ``out/states.npz`` and read back from it when there)."""
+    ``out/states.npz`` and read back from it when there): the ends of ``protocols``
+    (``{name: (Phase, ...)}``, default S. putrefaciens' 4 CCW, and 4 CCW + 12 CW turns) run
+    from ``make_config(protocol)`` (default this study's case)."""
     from flagwrap.elasticity.rod import Frames
 
+    make_config = make_config or (lambda protocol: base_config(protocol, None))
+    protocols = protocols or {"extended": (Phase("ccw", 4.0),),
+                              "wrapped": (Phase("ccw", 4.0), Phase("cw", 12.0))}
     cache = out / "states.npz"
     if cache.exists():
         z = np.load(cache)
         return {n: (z[f"{n}_y"], Frames(z[f"{n}_t"], z[f"{n}_d1"], z[f"{n}_rt"]))
-                for n in ("extended", "wrapped")}
+                for n in protocols}
     found, keep = {}, {}
-    for name, protocol in (("extended", (Phase("ccw", 4.0),)),
-                           ("wrapped", (Phase("ccw", 4.0), Phase("cw", 12.0)))):
+    for name, protocol in protocols.items():
         start = time.perf_counter()
-        tr = Simulation(base_config(protocol, None)).run()
+        tr = Simulation(make_config(protocol)).run()
         print(f"{name} state: {tr.status}, {tr.n_steps} steps, "
               f"{time.perf_counter() - start:.0f} s", flush=True)
         fr = tr.final_frames
