@@ -244,4 +244,7 @@ def main(argv=None):
 
 if __name__ == "__main__":
     os.environ.setdefault("OMP_NUM_THREADS", "1")
-    main()
+    try:
+        main()
+    except RunInterrupted as exc:  # the run file holds what was computed; the checkpoint resumes
+        sys.exit(f"stopped: {exc}")
