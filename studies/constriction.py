@@ -98,10 +98,10 @@ class Passage:
         b = np.asarray(traj.body[-1], float)
         zc = b[2] + self.c * body_axis(b[3:7])[2]
         self.track.append(zc)
-        print(f"  period {len(self.track)}: body centre {zc - self.z_neck:+.4f} L from the "
+        print(f"  period {self.next - 1:.0f}: body centre {zc - self.z_neck:+.4f} L from the "
               f"neck's middle, {len(traj.t)} frames", flush=True)
         if self.sign * (zc - self.z_neck) > 0:
-            return f"passes: the body centre is past the neck's middle after {len(self.track)} periods"
+            return f"passes: the body centre is past the neck's middle after {self.next - 1:.0f} periods"
         if len(self.track) > self.window and \
                 abs(self.track[-1] - self.track[-1 - self.window]) < self.stuck:
             return (f"stuck: the body centre moved {abs(self.track[-1] - self.track[-1 - self.window]):.2e} L "
