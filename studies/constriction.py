@@ -1,8 +1,9 @@
 """C. insecticola swimming into a constricted tube: does it pass, and in which mode
-(docs/confinement.md, "C. insecticola through a constriction").
+(docs/confinement.md, "C. insecticola into a constriction").
 
 Run: ``python studies/constriction.py [--modes wrapped extended] [--tube-radius 1.25]
 [--neck 0.5] [--neck-length 2] [--spacing 0.2] [--max-turns 40] [--out out/constriction]``
+(the docs' runs: ``--modes wrapped --spacing 0.25 [--neck 0.4]``)
 
 1. The two swimming states of ``examples/c_insecticola_torque_speed.toml`` (E. coli's
    torque-speed line, 4500 pN nm stall: the motor that makes this cell wrap,
@@ -15,8 +16,8 @@ Run: ``python studies/constriction.py [--modes wrapped extended] [--tube-radius 
 3. The same state inside an open tube of radius ``--tube-radius`` about the body's axis with a
    cosine constriction to ``--neck`` (radius, um) over ``--neck-length`` um, placed ahead of
    the cell in its swimming direction (the cell turned to swim towards +z), its start
-   ``--lead`` um beyond the cell's leading point; the tube reaches ``--behind`` um behind the cell and ``--beyond`` um past the neck.
-   Blobs ``--spacing`` um apart. The run goes on until the body's centre has passed the
+   ``--lead`` um beyond the cell's leading point; the tube reaches ``--behind`` um behind
+   the cell and ``--beyond`` um past the neck. Blobs ``--spacing`` um apart. The run goes on until the body's centre has passed the
    neck's middle (**passes**), or has moved less than ``--stuck`` um along the axis over the
    last ``--window`` reference periods (**stuck**), or ``--max-turns`` periods.
 
@@ -39,7 +40,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 
+from tube_swimming import at_origin
+
 from flagwrap.cases import case_files
+from flagwrap.geometry.frames import quaternion_matrix
 from flagwrap.io.config import load_config
 from flagwrap.params import Phase
 from flagwrap.simulation import TWO_PI, RunInterrupted, Simulation
@@ -64,29 +68,14 @@ def states(out: Path):
                             "wrapped": (Phase("ccw", 3.0), Phase("cw", 12.0))})
 
 
-def at_origin(system, y, flip=False):
-    """The state with its pole at the origin, its body along +z (``flip``: along -z, turned
-    by pi about x)."""
-    y = np.array(y, float)
-    y[system.sl_X] = 0.0
-    y[system.sl_q] = (0.0, 1.0, 0.0, 0.0) if flip else (1.0, 0.0, 0.0, 0.0)
-    return y
-
-
-def body_axis(q) -> np.ndarray:
-    """The body's axis (its +z) in the lab from the unit quaternion (w, x, y, z)."""
-    w, x, y, z = q
-    return np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
-
-
 class Passage:
     """Terminating event: every reference period, the body centre's coordinate along the
-    tube's axis (+z) relative to the neck's middle; "passes" once it is beyond the middle on
-    the far side, "stuck" once it moved less than ``stuck`` over the last ``window`` periods.
-    ``sign`` is the swimming direction along z (+1 or -1); lengths in core units (L)."""
+    tube's axis (+z, the way the cell swims) relative to the neck's middle; "passes" once it
+    is beyond the middle, "stuck" once it moved less than ``stuck`` over the last ``window``
+    periods. Lengths in core units (L); ``centre_offset`` the body centre from the pole."""
 
-    def __init__(self, z_neck, sign, centre_offset, stuck, window):
-        self.z_neck, self.sign, self.c = z_neck, sign, centre_offset
+    def __init__(self, z_neck, centre_offset, stuck, window):
+        self.z_neck, self.c = z_neck, centre_offset
         self.stuck, self.window = stuck, int(window)
         self.track: list[float] = []
         self.next = 1.0
@@ -96,11 +85,11 @@ class Passage:
             return ""
         self.next += 1.0
         b = np.asarray(traj.body[-1], float)
-        zc = b[2] + self.c * body_axis(b[3:7])[2]
+        zc = b[2] + self.c * quaternion_matrix(b[3:7])[2, 2]
         self.track.append(zc)
         print(f"  period {self.next - 1:.0f}: body centre {zc - self.z_neck:+.4f} L from the "
               f"neck's middle, {len(traj.t)} frames", flush=True)
-        if self.sign * (zc - self.z_neck) > 0:
+        if zc > self.z_neck:
             return f"passes: the body centre is past the neck's middle after {self.next - 1:.0f} periods"
         if len(self.track) > self.window and \
                 abs(self.track[-1] - self.track[-1 - self.window]) < self.stuck:
@@ -150,8 +139,7 @@ def per_period(path, z_neck_m=0.0):
     X = ds["body_position"].values
     q = ds["body_orientation"].values
     half = (cfg.body.radius + cfg.body.cylinder_length) / 2
-    axis = np.array([body_axis(qq) for qq in q])
-    centre = X + half * axis
+    centre = X + half * quaternion_matrix(q)[:, :, 2]
     x = ds["position"].values
     a = cfg.filament.cross_section_radius  # the gap of the filament's surface, as wall_summary's
     tube = cfg.tubes[0].geometry(1.0) if cfg.tubes else None
@@ -161,7 +149,7 @@ def per_period(path, z_neck_m=0.0):
         if not m.any():
             continue
         j = np.flatnonzero(m)[-1]
-        gap = (float(min(tube.gap(xx).min() for xx in x[m])) - a) * 1e9 if tube else math.nan
+        gap = (float(tube.gap(x[m].reshape(-1, 3)).min()) - a) * 1e9 if tube else math.nan
         rows.append((t[j], (centre[j, 2] - z_neck_m) / UM,
                      float(np.mean(ds["omega"].values[m])) / TWO_PI,
                      float(np.mean(ds["motor_torque"].values[m])) * 1e21,
@@ -226,7 +214,7 @@ def main(argv=None):
               f"{env:.2f} um, cell z {lo:.2f} to {hi:.2f} um; neck's middle at {z_neck:+.2f} um, "
               f"tube {back:+.2f} to {front:+.2f} um", flush=True)
         half = (cfg.body.radius + cfg.body.cylinder_length) / 2 / L
-        stop = Passage(z_neck * UM / L, 1.0, half, args.stuck * UM / L, args.window)
+        stop = Passage(z_neck * UM / L, half, args.stuck * UM / L, args.window)
         tag = f"Rt{args.tube_radius:g}_Rc{args.neck:g}_lc{args.neck_length:g}_h{args.spacing:g}"
         path = out / f"{mode}_{tag}.nc"
         tr, wall = run(cfg.replace(tubes=(tube,)), y0, base, args.max_turns, path, stop=stop,

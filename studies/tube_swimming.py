@@ -88,10 +88,12 @@ def states(out: Path, make_config=None, protocols=None):
     return found
 
 
-def at_origin(system, y):
+def at_origin(system, y, flip=False):
+    """The state with its pole at the origin, its body along +z (``flip``: along -z, turned
+    by pi about x)."""
     y = np.array(y, float)
     y[system.sl_X] = 0.0
-    y[system.sl_q] = (1.0, 0.0, 0.0, 0.0)
+    y[system.sl_q] = (0.0, 1.0, 0.0, 0.0) if flip else (1.0, 0.0, 0.0, 0.0)
     return y
 
 
