@@ -396,3 +396,98 @@ def test_movies_and_snapshots_draw_the_wall_seen_edge_on():
     assert boundary_lines(cfg, CAMERAS[0]) == []
     (u, v), = boundary_lines(cfg, CAMERAS[1])
     assert np.allclose(u, -0.08) and np.ptp(v) > 10 * cfg.filament.length
+
+
+def test_stage_hessian_looks_ahead_of_the_cut_off_and_nowhere_else(rng):
+    # W's stiffness (docs in flagwrap.interactions.wall): beads deep in the contact keep the
+    # exact Hessian, beads within the lookahead of the cut-off (either side) get the law's
+    # stiffness that far inside, beads beyond it none
+    from flagwrap.hydrodynamics.wall import PlaneWall
+    from flagwrap.interactions.wall import WallContact
+
+    wall = PlaneWall([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+    c = WallContact(wall, cutoff=0.02, strength=3.0, active=np.ones(5, bool))
+    la = c.lookahead
+    assert la == pytest.approx(0.25 * (0.02 - 0.02 / 2 ** (1 / 6)) * 2)
+    h = np.array([0.012, 0.02 - 0.5 * la, 0.02, 0.02 + 0.5 * la, 0.02 + 2 * la])
+    x = np.column_stack([rng.normal(size=(5, 2)), h])
+
+    def zz(hess):
+        out = np.zeros(15)
+        trip = hess(x, None)
+        if trip is not None:
+            r, cc, v = trip
+            np.add.at(out, r[r == cc], v[r == cc])
+        return out[2::3]
+
+    exact, stage = zz(c.hessian_coo), zz(c.stage_hessian_coo)
+    k_ahead = c.law([0.02 - la])[2][0]
+    assert exact[0] > k_ahead and stage[0] == exact[0]  # deep: the law's own
+    assert 0 < exact[1] < k_ahead and stage[1] == k_ahead  # inside, near the cut-off
+    assert exact[2] == exact[3] == 0 and stage[2] == stage[3] == k_ahead  # at and just beyond
+    assert exact[4] == stage[4] == 0  # out of reach
+    # and the forces are the law's: the lookahead is in W only
+    g = np.zeros((5, 3))
+    c.energy_grad(x, None, g, None)
+    assert np.all(g[2:] == 0)
+
+
+def _free_sphere_under(gap_in_cutoffs, normal=(0.0, 0.0, -1.0)):
+    """The free sphere of FREE_SPHERE with a wall of normal ``normal`` this many contact
+    cut-offs from its nearest blob's surface."""
+    from flagwrap.body.boundaries import WallFromBody
+    from flagwrap.hydrodynamics.wall import PlaneWall
+    from flagwrap.simulation import make_system
+
+    s = make_system(config_from_dict(tomllib.loads(tiny_toml() + FREE_SPHERE + (
+        "[[wall]]\npoint = [0.0, 0.0, 0.1]\nnormal = [0.0, 0.0, -1.0]\n"))))
+    y = s.initial_y()
+    n = np.asarray(normal) / np.linalg.norm(normal)
+    top = float(np.max(-(s.blobs @ n) + s.blob_radii))  # the blobs' reach along -n
+    d = top + gap_in_cutoffs * s._boundary_contact.cutoff
+    s.boundary = WallFromBody(PlaneWall(-d * n, n))
+    s._body_cache = (None, None)
+    return s, y
+
+
+def test_the_bodys_contact_stiffness_is_its_loads_derivative_under_a_translation():
+    # K = d[F; T]/dxi (body axes) by central differences of wall_load as the body moves:
+    # exact for translations beside a plane; symmetric and negative semidefinite. A wall whose
+    # blob gaps avoid the lookahead band, so the stage law is the law itself there
+    from flagwrap.geometry.frames import quaternion_matrix
+
+    n = (0.3, -0.2, -1.0)
+    for off in np.linspace(0.3, 0.6, 31):
+        s, y = _free_sphere_under(off, n)
+        c = s._boundary_contact
+        g = s._view(y).gap_gradient(s.blobs)[0] - s.blob_radii
+        if not np.any(np.abs(g - c.cutoff) < 1.5 * c.lookahead):
+            break
+    else:
+        pytest.fail("no wall position clear of the lookahead band")
+    K = s.contact_stiffness(y)
+    assert K is not None and np.abs(K).max() > 0
+    R = quaternion_matrix(y[s.sl_q])
+    h = 1e-4 * c.lookahead
+    for k in range(3):
+        dX = h * R[:, k]
+        yp, ym = y.copy(), y.copy()
+        yp[s.sl_X] += dX
+        ym[s.sl_X] -= dX
+        col = (s.wall_load(yp) - s.wall_load(ym)) / (2 * h)
+        np.testing.assert_allclose(K[:, k], col, rtol=1e-5, atol=1e-7 * np.abs(K).max())
+    assert np.allclose(K, K.T)
+    assert np.linalg.eigvalsh(K).max() <= 1e-9 * np.abs(K).max()
+
+
+def test_the_bodys_contact_stiffness_reaches_the_cut_off_and_goes_no_further():
+    # a sphere resting at the cut-off has no exact stiffness (the C2 law's is zero there)
+    # but W's looks ahead; beyond reach the pose block is the identity (pose_stiffness None)
+    s, y = _free_sphere_under(1.0)  # the top blob's surface at the cut-off
+    K = s.contact_stiffness(y)
+    assert K is not None and K[2, 2] < 0
+    P = s.pose_stiffness(y)
+    assert P.shape == (7, 7) and P[2, 2] < 0  # pushed back along z: decays, not grows
+    s, y = _free_sphere_under(1.0 + 1.5 * s._boundary_contact.lookahead
+                              / s._boundary_contact.cutoff)
+    assert s.contact_stiffness(y) is None and s.pose_stiffness(y) is None

@@ -48,7 +48,7 @@ class DenseW:
     def __init__(self, system, y, base, G0, gamma_h, reuse: bool = False, omega=None):
         from flagwrap.system.kernels import w_transpose_dense
 
-        rows, cols, vals = system.force_jacobian_coo(y, base, G0)
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0, stage=True)
         Mxx, mt = system.mobility_blocks(y, reuse=reuse, stage=True)
         WT = None
         if reuse:  # one W per step: factorise in the system's buffer (no fresh ~0.5 MB array)
@@ -145,11 +145,12 @@ class KrylovW:
         self.y = y
         self.gh = gamma_h
         self._gcr_setup(system.ny, rtol, maxiter, err_scale, kappa)
-        rows, cols, vals = system.force_jacobian_coo(y, base, G0, nonlocal_terms=False)
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0, nonlocal_terms=False,
+                                                     stage=True)
         self.P = BandedW(system, y, base, G0, gamma_h, width=width,
                          triplets=(rows, cols, vals))
         # the product sees every term; the banded preconditioner the chain-local ones
-        for r, c, v in system.interaction_jacobian_coo(y, "nonlocal"):
+        for r, c, v in system.interaction_jacobian_coo(y, "nonlocal", stage=True):
             rows, cols, vals = (np.concatenate([rows, r]), np.concatenate([cols, c]),
                                 np.concatenate([vals, v]))
         self.J = sp.csr_matrix((vals, (rows, cols)), shape=(system.ny, system.ny))
@@ -302,7 +303,8 @@ class BandedW:
 
         from flagwrap.system.kernels import band_from_triplets
 
-        rows, cols, vals = triplets or system.force_jacobian_coo(y, base, G0, nonlocal_terms=False)
+        rows, cols, vals = triplets or system.force_jacobian_coo(
+            y, base, G0, nonlocal_terms=False, stage=True)
         # pairs farther apart than the chain is long do not exist: clamp (short chains)
         width = min(int(width), max(system.nb - 1, 0)) if system.mobility.long_range else 0
         perm, inv, kl, ku = _band_structure(system, rows, cols, width)
@@ -346,7 +348,7 @@ class SparseW:
 
         if system.mobility.long_range:
             raise ValueError("SparseW needs a local mobility (numerics.hydrodynamics = false)")
-        rows, cols, vals = system.force_jacobian_coo(y, base, G0)
+        rows, cols, vals = system.force_jacobian_coo(y, base, G0, stage=True)
         d = system.local_mobility_diagonal()
         n = system.ny
         # W = I - gamma h diag(d) J assembled straight from the triplets (duplicates add)

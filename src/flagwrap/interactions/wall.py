@@ -6,6 +6,17 @@ through ``p`` with unit normal ``n`` (into the fluid), and ``u`` the cell body's
 ``contact.strength``), so that the filament meets a wall as it meets the body. The gradient is
 ``u'(d) n``; the Hessian ``u''(d) n n^T`` (a plane has no curvature). The joints' beads feel
 none (the motor holds them).
+
+The stage solver's ``W`` takes the Hessian with the law's stiffness *looked ahead*
+(:meth:`_BoundaryContact.stage_law`): a bead within :data:`STAGE_LOOKAHEAD` of the repulsive
+shell's width outside the cut-off, or anywhere inside it, gets at least the stiffness it would
+have that far inside. The C2 law's stiffness is zero at the cut-off, so a bead resting there
+carries none into ``W``, and a stage that moves it into the wall is then integrated
+explicitly against a stiffness of ~1e6 (core units): measured on the constricted tube's
+stall (docs/confinement.md, "C. insecticola into a constriction"), the exact ``W`` advanced
+the run 0.004 of a period in 238 s, the lookahead 1-6 nm 0.031-0.036 in 200-240 s. The forces
+are unchanged, and a W-method keeps its order for any ``W``; the exact Hessian
+(:meth:`hessian_coo`) is what the stability tools take.
 """
 
 from __future__ import annotations
@@ -13,6 +24,11 @@ from __future__ import annotations
 import numpy as np
 
 from flagwrap.body import _kernels as BK
+
+#: the stage solver's lookahead into the contact, a fraction of the repulsive shell's width
+#: ``cutoff - sigma`` (0.11 of the cut-off): half of it, 1.1 nm for a 10 nm bead at
+#: ``contact.range = 1``, within the 1-6 nm measured to work alike (module docstring)
+STAGE_LOOKAHEAD = 0.5
 
 
 def contact_law(config, bond: float) -> tuple[float, float, float]:
@@ -39,12 +55,32 @@ class _BoundaryContact:
         self.active = np.asarray(active, bool)
         self.distance = None  # the last evaluation's distances
         self.energy = 0.0
+        #: the stage solver's lookahead (module docstring) and the stiffness that far inside
+        self.lookahead = STAGE_LOOKAHEAD * (self.cutoff - self.sigma)
+        self._k_ahead = float(self.law([self.cutoff - self.lookahead])[2][0])
 
     def law(self, d):
+        """``(u, u', u'')`` of the contact law at distances ``d``."""
         d = np.ascontiguousarray(d, dtype=np.float64)
         e, dU, d2U = np.empty(len(d)), np.empty(len(d)), np.empty(len(d))
         BK.wca_law(d, self.sigma, self.strength, self.c2, e, dU, d2U)
         return e, dU, d2U
+
+    def stage_law(self, d):
+        """:meth:`law` with ``u''`` raised to at least its value ``lookahead`` inside the
+        cut-off wherever ``d < cutoff + lookahead`` (module docstring): for ``W`` only."""
+        e, dU, d2U = self.law(d)
+        near = np.asarray(d) < self.cutoff + self.lookahead
+        d2U[near] = np.maximum(d2U[near], self._k_ahead)
+        return e, dU, d2U
+
+    def hessian_coo(self, x, theta):
+        """``d^2U`` as COO triplets (:mod:`flagwrap.interactions.base`), exact."""
+        return self._hessian(x, self.law)
+
+    def stage_hessian_coo(self, x, theta):
+        """The stage solver's ``d^2U``: the Hessian on :meth:`stage_law`."""
+        return self._hessian(x, self.stage_law)
 
 
 class WallContact(_BoundaryContact):
@@ -68,9 +104,9 @@ class WallContact(_BoundaryContact):
         self.energy = float(e.sum())
         return self.energy
 
-    def hessian_coo(self, x, theta):
+    def _hessian(self, x, law):
         d = self.wall.heights(x)
-        _, _, d2U = self.law(np.where(self.active, d, np.inf))
+        _, _, d2U = law(np.where(self.active, d, np.inf))
         near = np.flatnonzero(d2U != 0.0)
         if near.size == 0:
             return None
@@ -106,10 +142,10 @@ class TubeContact(_BoundaryContact):
         self.energy = float(e.sum())
         return self.energy
 
-    def hessian_coo(self, x, theta):
+    def _hessian(self, x, law):
         ids = np.flatnonzero(self.active)
         g, dg, rhat, r = self.tube.gap_gradient(x[ids])
-        _, dU, d2U = self.law(g)
+        _, dU, d2U = law(g)
         near = np.flatnonzero(d2U != 0.0)
         if near.size == 0:
             return None

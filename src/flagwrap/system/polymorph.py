@@ -375,13 +375,14 @@ class PolymorphSystem(RodSystem):
         main += self.order_elastic_curvature
         return main, off
 
-    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
+    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True,
+                           stage: bool = False):
         """The rod's block (at the rest shape of ``y``'s ``phi``) and the order block; the
         cross terms are left out (module docstring)."""
         self.set_rest(y)
         r, c, v = self._rod.force_jacobian_coo(y[:self.n_rod], base,
                                                None if G0 is None else G0[:self.n_rod],
-                                               delta, nonlocal_terms)
+                                               delta, nonlocal_terms, stage)
         ro, co, vo = self.order_jacobian_coo(y)
         return np.concatenate([r, ro]), np.concatenate([c, co]), np.concatenate([v, vo])
 

@@ -402,9 +402,11 @@ class RodSystem:
             SK.unit_tangents(x[p.beads], t[p.bonds])
         return ForceInfo(G, x, theta, Frames(t, d1, rt), E, Ec, gx, gth, dist, Ei)
 
-    def interaction_jacobian_coo(self, y, which: str = "all"):
+    def interaction_jacobian_coo(self, y, which: str = "all", stage: bool = False):
         """``-d^2U/dy^2`` of the interactions as triplets over the unknowns; ``which``: "all",
-        "local" or "nonlocal" (by ``nonlocal_hessian``). Held coordinates are dropped."""
+        "local" or "nonlocal" (by ``nonlocal_hessian``). Held coordinates are dropped.
+        ``stage``: for the stage solver's ``W``: an interaction's ``stage_hessian_coo`` where
+        it has one (:mod:`flagwrap.interactions.base`), its exact Hessian otherwise."""
         parts = []
         if not self.interactions:
             return parts
@@ -413,7 +415,10 @@ class RodSystem:
             nl = bool(getattr(it, "nonlocal_hessian", False))
             if (which == "local" and nl) or (which == "nonlocal" and not nl):
                 continue
-            h = it.hessian_coo(x, theta) if hasattr(it, "hessian_coo") else None
+            if stage and hasattr(it, "stage_hessian_coo"):
+                h = it.stage_hessian_coo(x, theta)
+            else:
+                h = it.hessian_coo(x, theta) if hasattr(it, "hessian_coo") else None
             if h is None:
                 continue
             r, c, v = (np.asarray(a) for a in h)
@@ -571,7 +576,8 @@ class RodSystem:
 
     # Jacobian by coloured finite differences ------------------------------------------------
     def force_jacobian_coo(self, y: np.ndarray, base: Frames, G0: np.ndarray | None = None,
-                           delta: float | None = None, nonlocal_terms: bool = True):
+                           delta: float | None = None, nonlocal_terms: bool = True,
+                           stage: bool = False):
         """``dG/dy`` as COO triplets (rows, cols, vals; duplicates add), O(N) work and memory.
 
         ``delta``: difference step, default ``fd_step``. ``nonlocal_terms``: include the
@@ -579,7 +585,8 @@ class RodSystem:
         solvers pass False). Each filament's forces depend on its own unknowns only, so its
         block is the kernel's coloured differences on its unknowns
         (:meth:`FilamentPart.build_colors`); the interactions' terms are their own Hessians
-        (:meth:`interaction_jacobian_coo`), appended.
+        (:meth:`interaction_jacobian_coo`), appended; ``stage``: the stage solver's (exact
+        otherwise, as :meth:`force_jacobian` and the stability tools take it).
         """
         if delta is None:
             delta = self.fd_step
@@ -597,7 +604,7 @@ class RodSystem:
                                          *p.kernel_args(base, self.body, self._has_body),
                                          self.body.shape_code)
             trips.append((r, c, v) if p.ymap is None else (p.ymap[r], p.ymap[c], v))
-        trips += self.interaction_jacobian_coo(y, "all" if nonlocal_terms else "local")
+        trips += self.interaction_jacobian_coo(y, "all" if nonlocal_terms else "local", stage)
         if len(trips) == 1:
             return trips[0]
         return tuple(np.concatenate([t[k] for t in trips]) for k in range(3))

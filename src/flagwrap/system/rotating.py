@@ -280,13 +280,15 @@ class AtReferenceAngle:
     def forces(self, y, base):
         return super().forces(self._at_zero(y), base)
 
-    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True):
-        r, c, v = super().force_jacobian_coo(self._at_zero(y), base, G0, delta, nonlocal_terms)
+    def force_jacobian_coo(self, y, base, G0=None, delta=None, nonlocal_terms: bool = True,
+                           stage: bool = False):
+        r, c, v = super().force_jacobian_coo(self._at_zero(y), base, G0, delta, nonlocal_terms,
+                                             stage)
         keep = c != self.i_phi
         return r[keep], c[keep], v[keep]
 
-    def interaction_jacobian_coo(self, y, which: str = "all"):
-        return super().interaction_jacobian_coo(self._at_zero(y), which)
+    def interaction_jacobian_coo(self, y, which: str = "all", stage: bool = False):
+        return super().interaction_jacobian_coo(self._at_zero(y), which, stage)
 
     def motor_torque(self, info, phi: float, omega: float, y=None) -> float:
         """The system's own, from forces evaluated here with the clamp at ``phi = 0``."""

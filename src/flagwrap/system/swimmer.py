@@ -240,6 +240,44 @@ class SwimmerSystem(RodSystem):
         f = -dU[:, None] * dg  # the force on each blob, body axes
         return np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
 
+    def contact_stiffness(self, y) -> np.ndarray | None:
+        """``d[F; T]/dxi`` (6, 6) of the body's blobs' contact load (:meth:`wall_load`, body
+        axes) under a rigid displacement ``xi = [dx; dalpha]`` (body axes) on the contact's
+        stage law (:meth:`~flagwrap.interactions.wall._BoundaryContact.stage_law`, stiffness
+        looked ahead of the cut-off), or None where no blob is within its reach (and without
+        a boundary). For the stage solver's ``W``.
+
+        ``[F; T] = -sum u'(g_i) c_i``, ``c_i = [n_i; b_i x n_i]`` blob ``i``'s gap gradient
+        under ``xi``, so ``K = -sum u''(g_i) c_i c_i^T``; the terms in ``u'`` times the
+        boundary's curvature and the turning of ``n_i`` with ``dalpha`` are left out (the
+        W-method keeps its order for any ``W``): exact for a translation beside a plane."""
+        c = self._boundary_contact
+        if self.boundary is None or c is None:
+            return None
+        g, dg = self._view(y).gap_gradient(self.blobs)
+        g = g - self.blob_radii
+        near = np.flatnonzero(g < c.cutoff + c.lookahead)
+        if near.size == 0:
+            return None
+        _, _, d2U = c.stage_law(g[near])
+        C = np.concatenate([dg[near], np.cross(self.blobs[near], dg[near])], axis=1)
+        return -(C.T * d2U) @ C
+
+    def pose_stiffness(self, y) -> np.ndarray | None:
+        """``d(dpose/dt)/d(pose)`` (7, 7) through :meth:`contact_stiffness`, or None: the
+        body's velocity changes by ``N K xi / machin``, and the pose ``[X; q]`` relates to
+        ``xi`` by ``dX = R dx``, ``dq = Q(q) dalpha / 2`` (:func:`quaternion_rate_matrix`,
+        whose columns are orthonormal for a unit ``q``)."""
+        K = self.contact_stiffness(y)
+        if K is None:
+            return None
+        q = y[self.sl_q] / np.linalg.norm(y[self.sl_q])
+        R, Q = quaternion_matrix(q), quaternion_rate_matrix(q)
+        P, Pinv = np.zeros((7, 6)), np.zeros((6, 7))
+        P[:3, :3], P[3:, 3:] = R, 0.5 * Q
+        Pinv[:3, :3], Pinv[3:, 3:] = R.T, 2.0 * Q.T
+        return P @ (self._body(y)[2] / self.machin) @ K @ Pinv
+
     # mobility ------------------------------------------------------------------------------
     def _geometry(self, y):
         """Free beads' body-frame positions (nb, 3), free bonds' tangents (ne, 3), ``M_fb``.
@@ -456,7 +494,9 @@ class SwimmerW:
     over (filament, pose); ``A`` with the screening lagged (:meth:`SwimmerSystem.
     mobility_matrix`; without it while a bead touches the body), ``J`` the force Jacobian,
     ``P = [R(q) N_U; Q(q) N_Omega / 2] D / machin`` the pose rates per generalized force
-    (:func:`quaternion_rate_matrix`). A solve is the filament's LU, then the pose rows forward.
+    (:func:`quaternion_rate_matrix`); beside a boundary the pose block is ``I - gamma h
+    K_pp`` where the body's blobs touch it (:meth:`SwimmerSystem.pose_stiffness`), the
+    identity elsewhere. A solve is the filament's LU, then the pose rows forward.
     The filament block's LU is factorised in a buffer the system keeps (as
     :class:`~flagwrap.integrators.linear.DenseW` with ``reuse``): valid until the next
     ``SwimmerW`` of the same system, one per step."""
@@ -466,7 +506,7 @@ class SwimmerW:
         from flagwrap.system.kernels import left_product_coo, w_transpose_dense
 
         n = system.n_in
-        rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n])
+        rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n], stage=True)
         # the screening only while no bead touches the body: with a bead in contact the
         # screened W misses the stiff (dA/dx)[F_contact] of a mobility that falls steeply at
         # the wall, and the controller alternates accepted and rejected steps (measured:
@@ -488,12 +528,24 @@ class SwimmerW:
                             0.5 * quaternion_rate_matrix(q) @ ND[3:]])
         self.PJ = left_product_coo(P, rows, cols, vals, np.empty((7, n)))
         self.PJ *= gamma_h
+        self.pose_lu = pose_block(system, y, gamma_h)
 
     def solve(self, rhs):
         out = np.array(rhs, float)
         u = out[:self.n] = sla.lu_solve(self.lu, rhs[:self.n], check_finite=False)
         out[self.n:] += self.PJ @ u
+        if self.pose_lu is not None:
+            out[self.n:] = sla.lu_solve(self.pose_lu, out[self.n:], check_finite=False)
         return out
+
+
+def pose_block(system, y, gamma_h):
+    """The LU of ``W``'s pose block ``I - gamma h K_pp`` (:meth:`SwimmerSystem.
+    pose_stiffness`), or None where it is the identity."""
+    K = system.pose_stiffness(y)
+    if K is None:
+        return None
+    return sla.lu_factor(np.eye(7) - gamma_h * K, check_finite=False)
 
 
 class SwimmerFrame(RotatingFrame):
@@ -585,7 +637,8 @@ class SwimmerKrylovW(KrylovW):
     inherits), each product ``v - gamma h A (J v)`` with the swimmer's own mobility product
     (the body's blobs, its motion and every filament's hydrodynamics, exact:
     :meth:`SwimmerSystem.apply_mobility`), then the pose rows forward from one more product,
-    ``gamma h P J u`` being that product's pose rates.
+    ``gamma h P J u`` being that product's pose rates (and beside a boundary the pose block
+    of :class:`SwimmerW`).
 
     Preconditioner: each filament's own dense ``I - gamma h M_k J_kk``, ``M_k`` the
     free-space RPY among its free beads and its twists' local drag (no other filament), and
@@ -609,7 +662,7 @@ class SwimmerKrylovW(KrylovW):
         n = system.n_in
         self.system, self.y, self.gh, self.n = system, y, gamma_h, n
         self._gcr_setup(n, rtol, maxiter, None if err_scale is None else err_scale[:n], kappa)
-        rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n])
+        rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n], stage=True)
         self.J = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
         x, _, _ = system.unpack(y)
         x_free = x[system.free_beads]
@@ -635,6 +688,7 @@ class SwimmerKrylovW(KrylovW):
         # W_P = W_blocks - U V, U = gamma h D^T N / machin (n, 6), V = D J (6, n)
         self.P = _FilamentBlocks(blocks, gamma_h * (D.T @ N) / system.machin,
                                  np.asarray((self.J.T @ D.T).T), phi)
+        self.pose_lu = pose_block(system, y, gamma_h)
 
     def _product(self, v):
         """``A (J v)`` over the whole state (filaments and pose rows)."""
@@ -650,6 +704,8 @@ class SwimmerKrylovW(KrylovW):
         out = np.array(rhs, float)
         out[:self.n] = u
         out[self.n:] += self.gh * self._product(u)[self.n:]
+        if self.pose_lu is not None:
+            out[self.n:] = sla.lu_solve(self.pose_lu, out[self.n:], check_finite=False)
         return out
 
 
