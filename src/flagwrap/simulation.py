@@ -289,6 +289,10 @@ class Simulation:
             y = s.initial_y() if y0 is None else np.array(y0, float)
             base_in = (s.frames0.copy() if base is None else base)
             info = s.forces(y, base_in)
+            if y0 is not None:  # the config's checks saw its own start, not this one
+                from flagwrap.system.parts import check_start_state
+
+                check_start_state(self.config, s, y, info)
             t = t0
             h = self.h0
             self._record(traj, t, y, info, sched(t))

@@ -341,3 +341,11 @@ def test_analyze_reports_a_free_cell_in_a_tube(tmp_path, capsys):
     assert w["speed_radial"] == pytest.approx((r[k[-1]] - r[k[0]]) / dt, rel=1e-9)
     assert main(["analyze", str(path), "--no-store"]) == 0
     assert "um/s along it" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_a_run_from_a_state_across_the_tube_is_refused(kind):
+    from test_wall_system import _kind_config, check_a_start_state_across_the_boundary_is_refused
+
+    cfg = _kind_config(KINDS, kind, TUBE)
+    check_a_start_state_across_the_boundary_is_refused(cfg, np.array([0.1, 0.0, 0.0]))

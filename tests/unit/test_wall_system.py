@@ -491,3 +491,40 @@ def test_the_bodys_contact_stiffness_reaches_the_cut_off_and_goes_no_further():
     s, y = _free_sphere_under(1.0 + 1.5 * s._boundary_contact.lookahead
                               / s._boundary_contact.cutoff)
     assert s.contact_stiffness(y) is None and s.pose_stiffness(y) is None
+
+
+def _kind_config(kinds, kind, default_boundary):
+    numerics, tables, *more = kinds[kind]
+    fil = more[0] if more else None
+    boundary = more[1] if len(more) > 1 else default_boundary
+    text = tiny_toml(ccw=0.2, cw=0.1).replace("[numerics]\n", "[numerics]\n" + numerics)
+    if fil:
+        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil)
+    return config_from_dict(tomllib.loads(text + tables + boundary))
+
+
+def check_a_start_state_across_the_boundary_is_refused(cfg, shift):
+    """A run from ``y0`` (not the config's rest shape) with its filament (and a free body)
+    moved by ``shift`` (core units, lab axes) across the boundary is refused naming y0 before
+    any step; the unmoved state passes the same check."""
+    from flagwrap.simulation import Simulation
+    from flagwrap.system.parts import check_start_state
+
+    sim = Simulation(cfg)
+    s = sim.system
+    y = s.initial_y()
+    check_start_state(cfg, s, y, s.forces(y, s.frames0.copy()))  # the config's own start
+    bad = y.copy()
+    if hasattr(s, "sl_X"):  # a free cell: move the whole cell
+        bad[s.sl_X] += shift
+    else:
+        bad[s.sl_x] = (bad[s.sl_x].reshape(-1, 3) + shift).ravel()
+    with pytest.raises(UserInputError, match=r"^y0: (bead \d+ starts|the cell body crosses)"):
+        sim.run(y0=bad)
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_a_run_from_a_state_across_the_wall_is_refused(kind):
+    cfg = _kind_config(KINDS, kind, SIDE)
+    n = np.asarray(cfg.walls[0].unit_normal)
+    check_a_start_state_across_the_boundary_is_refused(cfg, -0.5 * n)

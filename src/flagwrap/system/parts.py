@@ -458,6 +458,40 @@ def check_walls(config) -> None:
                                  f"wall ({-h:.3g} m behind it): move the wall or turn its normal")
 
 
+def check_start_state(config, system, y, info) -> None:
+    """Refuse a run that starts from a given state (``Simulation.run(y0=...)``) with a bead
+    within its radius of the config's wall or tube (or behind it), or a free body's blob
+    centre across it: one line naming ``y0``, before any step. The config's own checks
+    (:func:`check_walls`, :func:`check_tubes`) place the boundary against the config's rest
+    shape, which such a run does not start from. ``info``: the forces at ``y``."""
+    from flagwrap.errors import UserInputError
+
+    if config.walls:
+        from flagwrap.hydrodynamics.wall import config_wall
+
+        distance, what = config_wall(config).heights, "wall[0]"
+    elif config.tubes:
+        distance, what = config_tube(config).gap, "tube[0]"
+    else:
+        return
+    fil = config.filament
+    L, a = fil.length, fil.cross_section_radius
+    d = distance(np.asarray(system.record_view(y, info).x))
+    i = int(np.argmin(d))
+    if not d[i] * L >= a:
+        raise UserInputError(f"y0: bead {i} starts {d[i] * L:.3g} m from {what}'s wall (less "
+                             f"than its radius a = {a:.3g} m, or behind it): start the run "
+                             "from a state clear of the boundary")
+    if getattr(system, "blobs", None) is not None and hasattr(system, "pose"):
+        X, R = system.pose(y)
+        db = distance(X + system.blobs @ R.T)  # the blobs' centres, as the config's checks
+        if not db.min() > 0.0:
+            raise UserInputError(f"y0: the cell body crosses {what}'s wall (a blob "
+                                 f"{-db.min() * L:.3g} m behind it) at the state the run "
+                                 "starts from: start the run from a state clear of the "
+                                 "boundary")
+
+
 def config_tube(config):
     """The config's ``[[tube]]`` (one; :func:`check_tubes`) as a
     :class:`flagwrap.confinement.tube.Tube` in core units (lengths in ``L``), or None."""
