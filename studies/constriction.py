@@ -192,7 +192,8 @@ def main(argv=None):
         u_free = (free[-1][1] - free[0][1]) / (free[-1][0] - free[0][0])  # um/s over the last periods
         # The tube run is turned so that the cell swims towards +z: the config's own check
         # of a tube places it against the config's rest helix (hanging along -z from the
-        # pole), which a neck below the pole would cross; the run starts from the state.
+        # pole), which a neck below the pole would cross; the state the run starts from is
+        # checked against the tube by Simulation.run itself.
         flip = u_free < 0
         env = envelope_radius(free_path) / UM
         sim = Simulation(cfg)
