@@ -519,7 +519,7 @@ def check_a_start_state_across_the_boundary_is_refused(cfg, shift):
         bad[s.sl_X] += shift
     else:
         bad[s.sl_x] = (bad[s.sl_x].reshape(-1, 3) + shift).ravel()
-    with pytest.raises(UserInputError, match=r"^y0: (bead \d+ starts|the cell body crosses)"):
+    with pytest.raises(UserInputError, match=r"^y0: (bead \d+'s centre starts|the cell body crosses)"):
         sim.run(y0=bad)
 
 

@@ -11,6 +11,10 @@ joint, the body contact, gravity) and then every interaction in ``system.interac
   ``3 N + j``); the system maps them onto the unknowns and adds ``-d^2U`` to the Jacobian.
   ``None`` leaves the term out of ``W`` (the W-methods keep their order with any ``W``;
   only the step size can suffer where the term is stiff);
+* ``stage_hessian_coo(x, theta)`` (optional): the same for the stage solver's ``W`` only,
+  where a different stiffness steps better than the exact one (the boundary contacts look
+  their stiffness ahead of the law's cut-off: :mod:`flagwrap.interactions.wall`); without
+  it ``W`` takes ``hessian_coo``, and the stability tools always do;
 * ``nonlocal_hessian``: true when the triplets couple beads far apart along the chain (the
   banded solvers, whose band is fixed per system, leave those out; dense and Krylov use them);
 * ``rotation_invariant``: true when ``U`` is unchanged by a rotation of everything about the

@@ -459,11 +459,11 @@ def check_walls(config) -> None:
 
 
 def check_start_state(config, system, y, info) -> None:
-    """Refuse a run that starts from a given state (``Simulation.run(y0=...)``) with a bead
-    within its radius of the config's wall or tube (or behind it), or a free body's blob
-    centre across it: one line naming ``y0``, before any step. The config's own checks
-    (:func:`check_walls`, :func:`check_tubes`) place the boundary against the config's rest
-    shape, which such a run does not start from. ``info``: the forces at ``y``."""
+    """Refuse a run that starts from a given state (``Simulation.run(y0=...)``) with a bead's
+    or a free body's blob's centre on or behind the config's wall or tube: one line naming
+    ``y0``, before any step. The config's own checks (:func:`check_walls`,
+    :func:`check_tubes`) place the boundary against the config's rest shape, which such a
+    run does not start from. ``info``: the forces at ``y``."""
     from flagwrap.errors import UserInputError
 
     if config.walls:
@@ -474,14 +474,15 @@ def check_start_state(config, system, y, info) -> None:
         distance, what = config_tube(config).gap, "tube[0]"
     else:
         return
-    fil = config.filament
-    L, a = fil.length, fil.cross_section_radius
+    L = config.filament.length
     d = distance(np.asarray(system.record_view(y, info).x))
     i = int(np.argmin(d))
-    if not d[i] * L >= a:
-        raise UserInputError(f"y0: bead {i} starts {d[i] * L:.3g} m from {what}'s wall (less "
-                             f"than its radius a = {a:.3g} m, or behind it): start the run "
-                             "from a state clear of the boundary")
+    # the centre in front of the wall: a state the run reached may sit closer than ``a``
+    # (a contact law whose sigma is below ``a``), but behind it the law pushes nothing
+    if not d[i] > 0.0:
+        raise UserInputError(f"y0: bead {i}'s centre starts {-d[i] * L:.3g} m behind "
+                             f"{what}'s wall (or on it): start the run from a state clear of "
+                             "the boundary")
     if getattr(system, "blobs", None) is not None and hasattr(system, "pose"):
         X, R = system.pose(y)
         db = distance(X + system.blobs @ R.T)  # the blobs' centres, as the config's checks

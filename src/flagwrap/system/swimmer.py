@@ -35,11 +35,16 @@ The twist torques act on the fluid locally (the bond's rotational drag), as in t
 
 The body's pose (lab position ``X`` of its reference point and unit quaternion ``q``, body to
 lab) is carried in ``y`` after the filament's unknowns: ``dX/dt = R(q) U``, ``dq/dt =
-q (0, Omega) / 2``. Nothing depends on the pose (no gravity on a free cell), so the stage
-solver ``W`` is block lower triangular: the filament's ``I - gamma h A J`` (:class:`SwimmerW`),
-and the pose's rows ``-gamma h P J`` beside the identity, ``P`` the pose rates per generalized
-force. Those rows matter: the pose is driven by the filament's stiff modes, and without them
-its stages integrate those modes explicitly and the step controller halves the step. Run
+q (0, Omega) / 2``. In free space nothing depends on the pose (no gravity on a free cell),
+so the stage solver ``W`` is block lower triangular: the filament's ``I - gamma h A J``
+(:class:`SwimmerW`), and the pose's rows ``-gamma h P J`` beside the identity, ``P`` the pose
+rates per generalized force. Those rows matter: the pose is driven by the filament's stiff
+modes, and without them its stages integrate those modes explicitly and the step controller
+halves the step. Beside a wall or in a tube the contacts depend on the pose: ``W`` keeps the
+body's blobs' contact stiffness in its pose block (:meth:`SwimmerSystem.pose_stiffness`)
+and the beads' in the filament's block at the step's pose; how a bead's contact force
+changes as the whole cell moves (the block above the pose's) is left out, so ``W`` stays
+block lower triangular (the W-method keeps its order for any ``W``). Run
 files are written in the lab frame (:meth:`record_view`) and carry the body's pose and
 velocities (:meth:`body_record`).
 """
@@ -173,6 +178,14 @@ class SwimmerSystem(RodSystem):
     def _contact_rotation(self, y) -> np.ndarray:
         """Lab axes of the frame the forces are evaluated in (the body's here)."""
         return self.pose(y)[1]
+
+    def place_contacts(self, y) -> None:
+        """Place the filament's contact with a boundary at the pose of ``y`` (a full state):
+        what :meth:`forces` does first, and the stage solver before it differences the
+        forces (the last evaluation may have been a rejected step's stage, at another
+        pose)."""
+        if self._bead_contacts:
+            self._place_contacts(y)
 
     def _place_contacts(self, y) -> None:
         X, _ = self.pose(y)
@@ -506,6 +519,7 @@ class SwimmerW:
         from flagwrap.system.kernels import left_product_coo, w_transpose_dense
 
         n = system.n_in
+        system.place_contacts(y)
         rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n], stage=True)
         # the screening only while no bead touches the body: with a bead in contact the
         # screened W misses the stiff (dA/dx)[F_contact] of a mobility that falls steeply at
@@ -662,6 +676,7 @@ class SwimmerKrylovW(KrylovW):
         n = system.n_in
         self.system, self.y, self.gh, self.n = system, y, gamma_h, n
         self._gcr_setup(n, rtol, maxiter, None if err_scale is None else err_scale[:n], kappa)
+        system.place_contacts(y)
         rows, cols, vals = system.force_jacobian_coo(y[:n], base, G0[:n], stage=True)
         self.J = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
         x, _, _ = system.unpack(y)
