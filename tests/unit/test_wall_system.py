@@ -528,3 +528,82 @@ def test_a_run_from_a_state_across_the_wall_is_refused(kind):
     cfg = _kind_config(KINDS, kind, SIDE)
     n = np.asarray(cfg.walls[0].unit_normal)
     check_a_start_state_across_the_boundary_is_refused(cfg, -0.5 * n)
+
+
+def _free_cell_touching_a_tilted_wall(frame):
+    """The free sphere of FREE_SPHERE with the tiny filament, turned, its motor at 0.7 rad in
+    the turning frame, and a tilted wall under the filament's lowest bead, 0.3-0.7 contact
+    cut-offs from it and no bead in the lookahead band (where the stage law is the law)."""
+    from flagwrap.body.boundaries import WallFromBody
+    from flagwrap.hydrodynamics.wall import PlaneWall
+    from flagwrap.simulation import make_system
+
+    text = tiny_toml().replace("[numerics]\n", f"[numerics]\nframe = '{frame}'\n")
+    s = make_system(config_from_dict(tomllib.loads(
+        text + FREE_SPHERE + "[[wall]]\npoint = [0.0, 0.0, -5.0]\nnormal = [0.0, 0.0, 1.0]\n")))
+    y = s.initial_y()
+    if frame == "rotating":
+        y[s.i_phi] = 0.7
+    y[s.sl_q] = [math.cos(0.15), 0.6 * math.sin(0.15), 0.0, 0.8 * math.sin(0.15)]
+    base = s.frames0.copy()
+    xl = np.asarray(s.record_view(y, s.forces(y, base)).x)  # lab positions
+    c = s._bead_contacts[0]
+    n = np.array([0.2, -0.1, 1.0]) / math.sqrt(1.05)
+    for off in np.linspace(0.3, 0.7, 41):
+        gaps = (xl @ n).min() - xl @ n + off * c.cutoff
+        if not np.any(np.abs(gaps - c.cutoff) < 1.5 * c.lookahead):
+            break
+    s.boundary = WallFromBody(PlaneWall(((xl @ n).min() - off * c.cutoff) * n, n))
+    s._body_cache = (None, None)
+    return s, y, base
+
+
+@pytest.mark.parametrize("frame", ["lab", "rotating"])
+def test_the_beads_contact_forces_change_with_the_pose_as_differenced(frame):
+    # dG/dxi (the block of W above the pose's) against central differences of the forces as
+    # the whole cell translates (exact beside a plane), in the lab and the turning frame
+    from flagwrap.geometry.frames import quaternion_matrix
+
+    s, y, base = _free_cell_touching_a_tilted_wall(frame)
+    C = s.contact_pose_forces(y)
+    assert C is not None and np.count_nonzero(np.abs(C).sum(axis=1)) >= 3
+    R = quaternion_matrix(y[s.sl_q] / np.linalg.norm(y[s.sl_q]))
+    h = 1e-4 * s._bead_contacts[0].lookahead
+    for k in range(3):
+        yp, ym = y.copy(), y.copy()
+        yp[s.sl_X] += h * R[:, k]
+        ym[s.sl_X] -= h * R[:, k]
+        col = (s.forces(yp, base).G - s.forces(ym, base).G)[:s.n_in] / (2 * h)
+        # differences of a force of scale |C| h over a step h: ~1e-8 of |C| measured
+        np.testing.assert_allclose(C[:, k], col, rtol=0, atol=1e-6 * np.abs(C).max())
+
+
+@pytest.mark.parametrize("frame", ["lab", "rotating"])
+def test_the_swimmers_w_solves_its_coupled_blocks(frame, rng):
+    # with a bead in contact W = [[W11, W12], [-gamma h P J, I - gamma h K_pp]] is no longer
+    # block triangular: SwimmerW.solve through the pose's Schur complement solves it
+    from flagwrap.system.swimmer import SwimmerW
+
+    s, y, base = _free_cell_touching_a_tilted_wall(frame)
+    G0 = s.forces(y, base).G
+    gh = 1e-7
+    W = SwimmerW(s, y, base, G0, gh)
+    assert W.Z is not None
+    n = s.n_in
+    W11 = np.linalg.inv(np.linalg.solve(np.eye(n), sla_solve(W.lu, np.eye(n))))
+    K = s.pose_stiffness(y)
+    W22 = np.eye(7) - (0 if K is None else gh * K)
+    full = np.block([[W11, W11 @ W.Z], [-W.PJ, W22]])
+    r = rng.standard_normal(n + 7)
+    x = W.solve(r)
+    # a backward-stable solve: residual ~ n eps |W| |x| (W's entries reach ~1e6 here)
+    np.testing.assert_allclose(full @ x, r, rtol=0,
+                               atol=1e-12 * np.abs(full).max() * np.abs(x).max())
+    # and the coupling matters: the block-triangular solve misses W12 p by far more
+    assert np.abs(full[:n, n:] @ x[n:]).max() > 1e3 * np.abs(full @ x - r).max()
+
+
+def sla_solve(lu, B):
+    import scipy.linalg as sla
+
+    return sla.lu_solve(lu, B)
