@@ -2,14 +2,13 @@
 constriction"): resume a run from its checkpoint with the stage matrix ``W``'s boundary
 contact stiffness looked ahead ``DELTA`` nm (:data:`flagwrap.interactions.wall.STAGE_LOOKAHEAD`
 sets the package's own, half the contact law's repulsive shell: 1.1 nm here), or with
-``DELTA = exact``: the exact Hessian in ``W``, no pose block for the body's blobs and no
-block coupling the beads' contact to the pose (the package's ``W`` before the lookahead), or
-``triangular``: the package's ``W`` without that last block. The forces are the same in every case, and a W-method
+``DELTA = exact``: the exact Hessian in ``W`` and no pose block for the body's blobs (the
+package's ``W`` before the lookahead). The forces are the same in every case, and a W-method
 keeps its order for any ``W``: only the steps differ. Patches the package for this process
 only: a measurement, not a feature.
 
 Run: ``timeout -s TERM 240 python studies/contact_lookahead_probe.py CHECKPOINT DELTA``
-(DELTA in nm, ``package``, ``triangular`` or ``exact``); prints how far the run got before the signal.
+(DELTA in nm, ``package`` or ``exact``); prints how far the run got before the signal.
 """
 import sys
 import time
@@ -25,12 +24,10 @@ ck = read_checkpoint(sys.argv[1])
 mode = sys.argv[2]
 cfg = config_from_dict(tomllib.loads(ck.config_toml))
 L = cfg.filament.length
-if mode in ("exact", "triangular"):  # W without the block above the pose's
-    SwimmerSystem.contact_pose_forces = lambda self, y: None
 if mode == "exact":
     _BoundaryContact.stage_law = _BoundaryContact.law
     SwimmerSystem.pose_stiffness = lambda self, y: None
-elif mode not in ("package", "triangular"):
+elif mode != "package":
     delta = float(mode) * 1e-9 / L
     _init = _BoundaryContact.__init__
 

@@ -41,11 +41,10 @@ so the stage solver ``W`` is block lower triangular: the filament's ``I - gamma 
 rates per generalized force. Those rows matter: the pose is driven by the filament's stiff
 modes, and without them its stages integrate those modes explicitly and the step controller
 halves the step. Beside a wall or in a tube the contacts depend on the pose: ``W`` keeps the
-body's blobs' contact stiffness in its pose block (:meth:`SwimmerSystem.pose_stiffness`),
-the beads' in the filament's block at the step's pose, and how a bead's contact force
-changes as the whole cell moves (the block above the pose's, :meth:`SwimmerSystem.
-contact_pose_forces`; the dense :class:`SwimmerW` only: the matrix-free one leaves it out,
-as the W-method allows). Run
+body's blobs' contact stiffness in its pose block (:meth:`SwimmerSystem.pose_stiffness`)
+and the beads' in the filament's block at the step's pose; how a bead's contact force
+changes as the whole cell moves (the block above the pose's) is left out, so ``W`` stays
+block lower triangular (the W-method keeps its order for any ``W``). Run
 files are written in the lab frame (:meth:`record_view`) and carry the body's pose and
 velocities (:meth:`body_record`).
 """
@@ -285,43 +284,12 @@ class SwimmerSystem(RodSystem):
         K = self.contact_stiffness(y)
         if K is None:
             return None
-        P, Pinv = pose_maps(y[self.sl_q])
+        q = y[self.sl_q] / np.linalg.norm(y[self.sl_q])
+        R, Q = quaternion_matrix(q), quaternion_rate_matrix(q)
+        P, Pinv = np.zeros((7, 6)), np.zeros((6, 7))
+        P[:3, :3], P[3:, 3:] = R, 0.5 * Q
+        Pinv[:3, :3], Pinv[3:, 3:] = R.T, 2.0 * Q.T
         return P @ (self._body(y)[2] / self.machin) @ K @ Pinv
-
-    def contact_pose_forces(self, y) -> np.ndarray | None:
-        """``dG/dxi`` (n_in, 6): the change of the filament's generalized forces (its
-        unknowns) through the beads' contact with the boundary as the whole cell moves
-        rigidly by ``xi = [dx; dalpha]`` (body axes), on the contact's stage stiffness; None
-        where no bead is within its reach (and without a boundary). For the stage solver's
-        ``W`` (:class:`SwimmerW`).
-
-        The beads keep their coordinates; the boundary moves under them, which acts as the
-        beads moving by ``dx + dalpha x x_b`` (``x_b`` in body axes), turned into the axes the
-        forces are evaluated in (the turning frame's, :meth:`_contact_rotation`): so
-        ``dG_r/dxi = -sum_c H_rc T_c``, ``H`` the contact's stage Hessian and ``T_c = Rt^T
-        [I | -[x_b]_x]`` for bead ``c``. The terms in ``u'`` (the force's direction turning
-        with ``dalpha``, the tube's curvature) are left out: exact for a translation beside
-        a plane."""
-        if not self._bead_contacts or self.boundary is None:
-            return None
-        self._place_contacts(y)
-        x, theta, _ = self.unpack(y)
-        Rt = self.pose(y)[1].T @ self._contact_rotation(y)  # the forces' axes -> body axes
-        out = None
-        for it in self._bead_contacts:
-            h = it.stage_hessian_coo(x, theta)
-            if h is None:
-                continue
-            r, c, v = (np.asarray(a) for a in h)
-            yr = self._coord_y[r]
-            keep = yr >= 0
-            r, c, v, yr = r[keep], c[keep], v[keep], yr[keep]
-            e = Rt.T[c % 3]  # row k of Rt^T for each entry's column component k
-            T = np.concatenate([e, np.cross(x[c // 3] @ Rt.T, e)], axis=1)
-            if out is None:
-                out = np.zeros((self.n_in, 6))
-            np.add.at(out, yr, -v[:, None] * T)
-        return out
 
     # mobility ------------------------------------------------------------------------------
     def _geometry(self, y):
@@ -531,18 +499,6 @@ class SwimmerSystem(RodSystem):
 _NO_TWIST_BLOCK = np.empty(0)
 
 
-def pose_maps(q) -> tuple[np.ndarray, np.ndarray]:
-    """``(P, Pinv)`` (7, 6), (6, 7): the pose's change ``[dX; dq]`` from a rigid displacement
-    ``xi = [dx; dalpha]`` in body axes, ``dX = R(q) dx``, ``dq = Q(q) dalpha / 2``, and back
-    (``Q``'s columns are orthonormal for a unit ``q``)."""
-    q = np.asarray(q, float) / np.linalg.norm(q)
-    R, Q = quaternion_matrix(q), quaternion_rate_matrix(q)
-    P, Pinv = np.zeros((7, 6)), np.zeros((6, 7))
-    P[:3, :3], P[3:, 3:] = R, 0.5 * Q
-    Pinv[:3, :3], Pinv[3:, 3:] = R.T, 2.0 * Q.T
-    return P, Pinv
-
-
 class SwimmerW:
     """The swimmer's ``W = I - gamma h (dy/dt)/dy`` without the mobility's own change:
 
@@ -553,10 +509,7 @@ class SwimmerW:
     ``P = [R(q) N_U; Q(q) N_Omega / 2] D / machin`` the pose rates per generalized force
     (:func:`quaternion_rate_matrix`); beside a boundary the pose block is ``I - gamma h
     K_pp`` where the body's blobs touch it (:meth:`SwimmerSystem.pose_stiffness`), the
-    identity elsewhere; and where a bead is within reach of the boundary's contact, the block
-    above the pose's, ``-gamma h A (dG/dpose)`` (:meth:`SwimmerSystem.contact_pose_forces`),
-    solved through the pose's 7 x 7 Schur complement. A solve is the filament's LU, then the
-    pose rows (and then the filament's correction by the pose).
+    identity elsewhere. A solve is the filament's LU, then the pose rows forward.
     The filament block's LU is factorised in a buffer the system keeps (as
     :class:`~flagwrap.integrators.linear.DenseW` with ``reuse``): valid until the next
     ``SwimmerW`` of the same system, one per step."""
@@ -574,8 +527,6 @@ class SwimmerW:
         # 300 of 300 rejected from a wrapped C. insecticola state, 20 without the screening)
         touching = system.forces(y, base).contact_energy > 0.0
         A = system.mobility_matrix(y, screening=False if touching else "lagged", reuse=True)
-        C = system.contact_pose_forces(y)
-        W12 = None if C is None else -gamma_h * (A @ (C @ pose_maps(y[system.sl_q])[1]))
         WT = system.__dict__.get("_wt_buffer")
         if WT is None:
             WT = system._wt_buffer = np.empty((n, n))
@@ -591,14 +542,7 @@ class SwimmerW:
                             0.5 * quaternion_rate_matrix(q) @ ND[3:]])
         self.PJ = left_product_coo(P, rows, cols, vals, np.empty((7, n)))
         self.PJ *= gamma_h
-        self.Z = None
-        if W12 is None:
-            self.pose_lu = pose_block(system, y, gamma_h)
-        else:  # the pose's Schur complement W22 - W21 W11^-1 W12, W21 = -PJ
-            K = system.pose_stiffness(y)
-            W22 = np.eye(7) if K is None else np.eye(7) - gamma_h * K
-            self.Z = sla.lu_solve(self.lu, W12, check_finite=False)
-            self.pose_lu = sla.lu_factor(W22 + self.PJ @ self.Z, check_finite=False)
+        self.pose_lu = pose_block(system, y, gamma_h)
 
     def solve(self, rhs):
         out = np.array(rhs, float)
@@ -606,8 +550,6 @@ class SwimmerW:
         out[self.n:] += self.PJ @ u
         if self.pose_lu is not None:
             out[self.n:] = sla.lu_solve(self.pose_lu, out[self.n:], check_finite=False)
-        if self.Z is not None:
-            out[:self.n] -= self.Z @ out[self.n:]
         return out
 
 
