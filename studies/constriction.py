@@ -36,6 +36,11 @@ import sys
 import time
 from pathlib import Path
 
+# one thread each before numpy and numba load: two runs side by side with two BLAS and numba
+# threads each ran 2.5x slower per step on two cores
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -232,7 +237,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
     try:
         main()
     except RunInterrupted as exc:  # the run file holds what was computed; the checkpoint resumes
