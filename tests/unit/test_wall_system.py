@@ -34,6 +34,18 @@ KINDS = {
 }
 
 
+def _kind_config(kinds, kind, default_boundary):
+    """The tiny rig's config for ``kinds[kind]`` = (numerics lines, tables[, filament lines[,
+    boundary]]), with ``default_boundary`` where the kind names none."""
+    numerics, tables, *more = kinds[kind]
+    fil = more[0] if more else None
+    boundary = more[1] if len(more) > 1 else default_boundary
+    text = tiny_toml(ccw=0.2, cw=0.1).replace("[numerics]\n", "[numerics]\n" + numerics)
+    if fil:
+        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil)
+    return config_from_dict(tomllib.loads(text + tables + boundary))
+
+
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_every_kind_of_system_runs_beside_a_wall(kind, tmp_path):
     from flagwrap.hydrodynamics.tube import TubeMobility
@@ -42,13 +54,7 @@ def test_every_kind_of_system_runs_beside_a_wall(kind, tmp_path):
     from flagwrap.io.runfile import config_of, read_run, write_run
     from flagwrap.simulation import make_system, simulate
 
-    numerics, tables, *more = KINDS[kind]
-    fil = more[0] if more else None
-    wall = more[1] if len(more) > 1 else SIDE
-    text = tiny_toml(ccw=0.2, cw=0.1).replace("[numerics]\n", "[numerics]\n" + numerics)
-    if fil:
-        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil)
-    cfg = config_from_dict(tomllib.loads(text + tables + wall))
+    cfg = _kind_config(KINDS, kind, SIDE)
     s = make_system(cfg)
     assert any(isinstance(it, WallContact) for it in s.interactions)
     m = s.mobility.inner if isinstance(s.mobility, TubeMobility) else s.mobility
@@ -491,16 +497,6 @@ def test_the_bodys_contact_stiffness_reaches_the_cut_off_and_goes_no_further():
     s, y = _free_sphere_under(1.0 + 1.5 * s._boundary_contact.lookahead
                               / s._boundary_contact.cutoff)
     assert s.contact_stiffness(y) is None and s.pose_stiffness(y) is None
-
-
-def _kind_config(kinds, kind, default_boundary):
-    numerics, tables, *more = kinds[kind]
-    fil = more[0] if more else None
-    boundary = more[1] if len(more) > 1 else default_boundary
-    text = tiny_toml(ccw=0.2, cw=0.1).replace("[numerics]\n", "[numerics]\n" + numerics)
-    if fil:
-        text = text.replace("n_beads = 21\n", "n_beads = 21\n" + fil)
-    return config_from_dict(tomllib.loads(text + tables + boundary))
 
 
 def check_a_start_state_across_the_boundary_is_refused(cfg, shift):
