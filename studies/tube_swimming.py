@@ -33,6 +33,10 @@ import os
 import time
 from pathlib import Path
 
+# one BLAS and numba thread, set before numpy and numba load (runs go side by side)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
 import numpy as np
 
 from flagwrap.cases import case_files
@@ -204,5 +208,4 @@ def main(argv=None):
               f"| {off} | {gap} |")
 
 if __name__ == "__main__":
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
     main()

@@ -21,6 +21,10 @@ import math
 import os
 import time
 
+# one BLAS and numba thread, set before numpy and numba load (runs go side by side)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
 from flagwrap.cases import case_files
 from flagwrap.io.config import load_config
 from flagwrap.params import TubeWall
@@ -65,5 +69,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
     raise SystemExit(main())
