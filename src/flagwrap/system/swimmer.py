@@ -171,8 +171,8 @@ class SwimmerSystem(RodSystem):
     def forces(self, y, base):
         """RodSystem's, in the body frame, with the filament's contact with a boundary placed
         at ``y``'s pose (the only force that depends on the pose)."""
-        if self._bead_contacts and len(y) == self.ny:
-            self._place_contacts(y)
+        if len(y) == self.ny:
+            self.place_contacts(y)
         return RodSystem.forces(self, y, base)
 
     def _contact_rotation(self, y) -> np.ndarray:
@@ -183,11 +183,9 @@ class SwimmerSystem(RodSystem):
         """Place the filament's contact with a boundary at the pose of ``y`` (a full state):
         what :meth:`forces` does first, and the stage solver before it differences the
         forces (the last evaluation may have been a rejected step's stage, at another
-        pose)."""
-        if self._bead_contacts:
-            self._place_contacts(y)
-
-    def _place_contacts(self, y) -> None:
+        pose). Nothing without a boundary."""
+        if not self._bead_contacts:
+            return
         X, _ = self.pose(y)
         geometry = self.boundary.at(X, self._contact_rotation(y)).geometry
         for it in self._bead_contacts:
@@ -243,13 +241,19 @@ class SwimmerSystem(RodSystem):
             out[3:] += np.cross(x[on], fb).sum(axis=0)
         return out
 
+    def _blob_gaps(self, y) -> tuple[np.ndarray, np.ndarray]:
+        """The body's blobs' surface gaps to the boundary at the pose of ``y`` (centre's gap
+        less radius) and their gradients (body axes): what their contact law acts on."""
+        g, dg = self._view(y).gap_gradient(self.blobs)
+        return g - self.blob_radii, dg
+
     def wall_load(self, y) -> np.ndarray:
         """The body's own share of :meth:`external_load` (its blobs' contact), zero without a
         boundary."""
         if self.boundary is None or self._boundary_contact is None:
             return np.zeros(6)
-        g, dg = self._view(y).gap_gradient(self.blobs)
-        _, dU, _ = self._boundary_contact.law(g - self.blob_radii)
+        g, dg = self._blob_gaps(y)
+        _, dU, _ = self._boundary_contact.law(g)
         f = -dU[:, None] * dg  # the force on each blob, body axes
         return np.concatenate([f.sum(axis=0), np.cross(self.blobs, f).sum(axis=0)])
 
@@ -267,8 +271,7 @@ class SwimmerSystem(RodSystem):
         c = self._boundary_contact
         if self.boundary is None or c is None:
             return None
-        g, dg = self._view(y).gap_gradient(self.blobs)
-        g = g - self.blob_radii
+        g, dg = self._blob_gaps(y)
         near = np.flatnonzero(g < c.cutoff + c.lookahead)
         if near.size == 0:
             return None
@@ -819,8 +822,8 @@ class SwimmerRotating(AtReferenceAngle, SwimmerSystem):
     def forces(self, y, base):
         """The body frame's forces with the clamp at ``phi = 0``; a boundary's contact placed
         as this frame sees it (the body's pose, then turned back by ``phi``)."""
-        if self._bead_contacts and len(y) == self.ny:
-            self._place_contacts(y)
+        if len(y) == self.ny:
+            self.place_contacts(y)
         return RodSystem.forces(self, self._at_zero(y), base)
 
     def _contact_rotation(self, y) -> np.ndarray:
