@@ -31,15 +31,11 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
-import os
 import sys
 import time
 from pathlib import Path
 
-# one thread each before numpy and numba load: two runs side by side with two BLAS and numba
-# threads each ran 2.5x slower per step on two cores
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+import one_thread  # noqa: F401  (one thread per process, before numpy loads)
 
 import numpy as np
 

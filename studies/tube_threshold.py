@@ -18,12 +18,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import time
 
-# one BLAS and numba thread, set before numpy and numba load (runs go side by side)
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+import one_thread  # noqa: F401  (one thread per process, before numpy loads)
 
 from flagwrap.cases import case_files
 from flagwrap.io.config import load_config

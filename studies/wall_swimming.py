@@ -29,13 +29,10 @@ from __future__ import annotations
 import argparse
 import itertools
 import math
-import os
 import time
 from pathlib import Path
 
-# one BLAS and numba thread, set before numpy and numba load (runs go side by side)
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+import one_thread  # noqa: F401  (one thread per process, before numpy loads)
 
 import numpy as np
 import tube_swimming as ts
