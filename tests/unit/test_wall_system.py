@@ -414,7 +414,7 @@ def test_stage_hessian_looks_ahead_of_the_cut_off_and_nowhere_else(rng):
     wall = PlaneWall([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])
     c = WallContact(wall, cutoff=0.02, strength=3.0, active=np.ones(5, bool))
     la = c.lookahead
-    assert la == pytest.approx(0.25 * (0.02 - 0.02 / 2 ** (1 / 6)) * 2)
+    assert la == pytest.approx(0.5 * (0.02 - 0.02 / 2 ** (1 / 6)))  # half the shell
     h = np.array([0.012, 0.02 - 0.5 * la, 0.02, 0.02 + 0.5 * la, 0.02 + 2 * la])
     x = np.column_stack([rng.normal(size=(5, 2)), h])
 
